@@ -1,0 +1,43 @@
+// rayaudit: one program, several subcommands (each in its own cmd_*.cpp).
+// Exit codes: 0 ok, 1 a check failed, 2 bad input or usage.
+#include <algorithm>
+#include <iostream>
+
+#include "command.h"
+#include "errors.h"
+
+namespace ra::cli {
+std::vector<Command>& commands() {
+  static std::vector<Command> all;
+  return all;
+}
+}  // namespace ra::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"rayaudit: is your ray-intersection code right, and how fast is it?", "rayaudit"};
+  app.set_version_flag("--version", std::string("rayaudit ") + RAYAUDIT_VERSION);
+  app.require_subcommand(1);
+  auto& cmds = ra::cli::commands();
+  std::sort(cmds.begin(), cmds.end(), [](auto& a, auto& b) { return a.order < b.order; });
+  for (auto& c : cmds) c.setup(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version arrive here too, with exit code 0.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "rayaudit: " << e.what() << " (see --help)\n";
+    return 2;
+  } catch (const ra::cli::ExitCode& e) {
+    return e.code;
+  } catch (const ra::InputError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const ra::CheckFailed& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "rayaudit: internal error: " << e.what() << "\n";
+    return 3;
+  }
+  return 0;
+}
