@@ -6,7 +6,7 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
-#include <cstring>
+#include <bit>
 #include <limits>
 #include <optional>
 #include <string_view>
@@ -76,16 +76,14 @@ template <class T> Vec3<T> ulp_offset(const Vec3<T>& p, const Vec3<T>& n) {
     }
     if constexpr (sizeof(T) == 4) {
       const auto of = static_cast<std::int32_t>(T(256) * n[i]);
-      std::int32_t bits;
-      std::memcpy(&bits, &p[i], 4);
+      auto bits = std::bit_cast<std::int32_t>(float(p[i]));
       bits += (p[i] < 0) ? -of : of;
-      std::memcpy(&r[i], &bits, 4);
+      r[i] = T(std::bit_cast<float>(bits));
     } else {
       const auto of = static_cast<std::int64_t>(T(256) * T(536870912.0) * n[i]);
-      std::int64_t bits;
-      std::memcpy(&bits, &p[i], 8);
+      auto bits = std::bit_cast<std::int64_t>(double(p[i]));
       bits += (p[i] < 0) ? -of : of;
-      std::memcpy(&r[i], &bits, 8);
+      r[i] = T(std::bit_cast<double>(bits));
     }
   }
   return r;

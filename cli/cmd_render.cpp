@@ -1,0 +1,94 @@
+// `rayaudit render SCENE -o OUT`: renders a scene file (or a bare .obj).
+#include <iostream>
+
+#include "command.h"
+#include "errors.h"
+#include "registry.h"
+#include "render.h"
+#include "scene.h"
+
+namespace {
+
+struct Args {
+  std::string scene, out;
+  int width = 0, height = 0, threads = 0, spp = 1, bits = 8;
+  std::vector<std::string> methods;
+  std::string precision = "double", accel = "none", self_intersection = "pov";
+  bool cull = false, srgb = false;
+};
+
+// --spp N means N samples per pixel on an n x n grid, so N must be a square.
+int samples_per_axis(int spp) {
+  for (int n = 1; n <= 16; ++n)
+    if (n * n == spp) return n;
+  throw ra::InputError("--spp must be a square number of samples per pixel (1, 4, 9, ... 256), got " +
+                       std::to_string(spp));
+}
+
+void run(const Args& a) {
+  ra::RenderOptions opt;
+  for (const auto& name : a.methods) {
+    const ra::Method* m = ra::find_method(name);
+    if (!m)
+      throw ra::InputError("unknown method \"" + name + "\"; triangle methods: " +
+                           ra::method_names(ra::Kind::triangle) +
+                           "; sphere methods: " + ra::method_names(ra::Kind::sphere));
+    if (m->kind == ra::Kind::triangle) opt.triangle_method = name;
+    else if (m->kind == ra::Kind::sphere) opt.sphere_method = name;
+  }
+  if (a.precision == "float") opt.use_double = false;
+  else if (a.precision != "double")
+    throw ra::InputError("--precision must be float or double, got \"" + a.precision + "\"");
+  auto accel = ra::parse_accel(a.accel);
+  if (!accel) throw ra::InputError("--accel must be none, sphere or bvh, got \"" + a.accel + "\"");
+  opt.accel = *accel;
+  auto si = ra::parse_self_intersection(a.self_intersection);
+  if (!si)
+    throw ra::InputError("--self-intersection must be one of " + std::string(ra::kSelfIntersectionNames) +
+                         ", got \"" + a.self_intersection + "\"");
+  opt.self_intersection = *si;
+  opt.cull = a.cull;
+  opt.threads = a.threads;
+  opt.samples_per_axis = samples_per_axis(a.spp);
+  if (a.bits != 8 && a.bits != 16) throw ra::InputError("--bits must be 8 or 16");
+  {
+    // Check the output path before the (possibly long) render.
+    std::string ext = std::filesystem::path(a.out).extension().string();
+    if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR")
+      throw ra::InputError(a.out + ": output must be .png or .exr");
+  }
+  ra::Scene scene = ra::load_scene(a.scene);
+  if (a.width > 0) scene.width = a.width;
+  if (a.height > 0) scene.height = a.height;
+  if (a.width > 0 || a.height > 0) ra::apply_content_defaults(scene);
+  const ra::Image img = ra::render(scene, opt);
+  ra::write_image(a.out, img, {a.bits, a.srgb});
+}
+
+void setup(CLI::App& app) {
+  auto args = std::make_shared<Args>();
+  auto* cmd = app.add_subcommand("render", "Render a scene (.json, or a bare .obj) to PNG or EXR");
+  cmd->add_option("scene", args->scene, "Scene file (.json) or mesh (.obj)")->required();
+  cmd->add_option("-o,--output", args->out, "Output image (.png or .exr)")->required();
+  cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--threads", args->threads, "Threads (default: all cores)")->check(CLI::Range(0, 1024));
+  cmd->add_option("--spp", args->spp, "Samples per pixel on an n x n grid: 1, 4, 9, ... (default 1)")
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--method", args->methods,
+                  "Intersection method by name (see `rayaudit methods`); a triangle and a sphere "
+                  "method may both be given")
+      ->take_all();
+  cmd->add_option("--precision", args->precision, "Intersection precision: float or double (default double)");
+  cmd->add_flag("--cull", args->cull, "Backface culling of triangles");
+  cmd->add_option("--accel", args->accel, "Acceleration: none, sphere (bounding spheres) or bvh");
+  cmd->add_option("--self-intersection", args->self_intersection,
+                  "Secondary-ray strategy: eps, pov (default), normal-offset, ulp-offset");
+  cmd->add_option("--bits", args->bits, "PNG bits per channel: 8 or 16 (default 8)");
+  cmd->add_flag("--srgb", args->srgb, "sRGB-encode the PNG (default: linear values)");
+  cmd->callback([args] { run(*args); });
+}
+
+ra::cli::Registrar reg(10, setup);
+
+}  // namespace

@@ -1,0 +1,36 @@
+// Linear float RGB images and their files, through OpenImageIO: PNG 8 or 16
+// bits per channel (linear values unless sRGB is asked for), EXR float.
+#pragma once
+#include <filesystem>
+#include <vector>
+
+#include "vec.h"
+
+namespace ra {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // row-major, row 0 at the top, 3 floats a pixel
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), rgb(std::size_t(w) * h * 3, 0.f) {}
+  float* at(int x, int y) { return &rgb[(std::size_t(y) * width + x) * 3]; }
+  const float* at(int x, int y) const { return &rgb[(std::size_t(y) * width + x) * 3]; }
+};
+
+struct ImageWriteOptions {
+  int bits = 8;       // 8 or 16 for PNG; EXR is always float
+  bool srgb = false;  // encode with the sRGB curve (PNG only)
+};
+
+// Quantises as POV-Ray does: floor(clamp(x, 0, 1) * max + 0.5).
+unsigned quantize(float x, unsigned max);
+
+// Writes atomically (temporary file renamed into place). The format comes
+// from the extension: .png or .exr. Throws InputError on failure.
+void write_image(const std::filesystem::path& path, const Image& img, const ImageWriteOptions& opt = {});
+
+// Reads any image OpenImageIO can read, as linear float RGB (no colour
+// conversion: a PNG's 8-bit values v become v / 255).
+Image read_image(const std::filesystem::path& path);
+
+}  // namespace ra

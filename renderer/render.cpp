@@ -1,0 +1,421 @@
+#include "render.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <thread>
+
+#include "camera.h"
+#include "errors.h"
+#include "registry.h"
+
+namespace ra {
+
+std::optional<Accel> parse_accel(std::string_view s) {
+  if (s == "none") return Accel::none;
+  if (s == "sphere") return Accel::sphere;
+  if (s == "bvh") return Accel::bvh;
+  return std::nullopt;
+}
+const char* accel_name(Accel a) {
+  switch (a) {
+    case Accel::none: return "none";
+    case Accel::sphere: return "sphere";
+    case Accel::bvh: return "bvh";
+  }
+  return "?";
+}
+
+namespace {
+
+// POV-Ray skips a light whose N.L is below this (trace.cpp).
+constexpr double kMinCosIncidence = 1e-10;
+
+// A mesh ready for tracing at precision T: each triangle's prepared bytes
+// for the chosen method, its unit geometric normal, and the bounding sphere
+// of document 002's optimisation.
+template <class T>
+struct PreparedMesh {
+  const TriangleSet* set = nullptr;
+  std::size_t stride = 0;
+  std::vector<unsigned char> pre;
+  std::vector<Vec3d> gnormal;        // per triangle, (B-A)x(C-A) normalised
+  std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
+  Vec3d bs_center;
+  double bs_radius = 0;
+};
+
+// Does the segment [tmin, tmax] of the ray pass through the solid ball?
+// Conservative (inflated by a relative 1e-6) so that it never rejects a mesh
+// the ray could hit.
+bool segment_meets_ball(const Ray<double>& r, const Vec3d& c, double radius) {
+  const double dd = dot(r.d, r.d);
+  double t = dot(c - r.o, r.d) / dd;
+  t = std::clamp(t, r.tmin, std::isfinite(r.tmax) ? r.tmax : std::max(t, r.tmin));
+  const Vec3d q = r.o + r.d * t - c;
+  const double rr = radius * (1 + 1e-6) + 1e-12 * length(c);
+  return dot(q, q) <= rr * rr;
+}
+
+// Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
+// object, then the lower triangle, so the answer does not depend on the order
+// an acceleration structure visits them in.
+bool nearer(double t, int object, int prim, const SceneHit& best) {
+  if (t != best.t) return t < best.t;
+  if (object != best.object) return object < best.object;
+  return prim < best.prim;
+}
+
+}  // namespace
+
+struct Tracer::Impl {
+  const Scene& scene;
+  RenderOptions opt;
+  Camera camera;
+  const Method* tri_method;
+  const Method* sph_method;
+  const Method* pln_method;
+
+  std::vector<PreparedMesh<float>> meshes_f;
+  std::vector<PreparedMesh<double>> meshes_d;
+  std::vector<int> mesh_index;  // object -> index into meshes_*, or -1
+
+  Impl(const Scene& s, const RenderOptions& o)
+      : scene(s), opt(o), camera(s.camera, s.width, s.height) {
+    tri_method = find_method(o.triangle_method);
+    if (!tri_method || tri_method->kind != Kind::triangle)
+      throw InputError("unknown triangle method \"" + o.triangle_method +
+                       "\"; valid: " + method_names(Kind::triangle));
+    sph_method = find_method(o.sphere_method);
+    if (!sph_method || sph_method->kind != Kind::sphere)
+      throw InputError("unknown sphere method \"" + o.sphere_method +
+                       "\"; valid: " + method_names(Kind::sphere));
+    pln_method = &default_method(Kind::plane);
+    if (o.samples_per_axis < 1 || o.samples_per_axis > 16)
+      throw InputError("samples per axis must be between 1 and 16");
+    mesh_index.assign(s.objects.size(), -1);
+    for (std::size_t i = 0; i < s.objects.size(); ++i) {
+      if (s.objects[i].kind != Object::Kind::mesh) continue;
+      mesh_index[i] = int(opt.use_double ? meshes_d.size() : meshes_f.size());
+      if (opt.use_double) meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
+      else meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
+    }
+  }
+
+  template <class T>
+  PreparedMesh<T> prepare(const TriangleSet& set) const {
+    PreparedMesh<T> m;
+    m.set = &set;
+    const auto& k = tri_method->triangle<T>();
+    m.stride = k.pre_bytes;
+    m.pre.resize(m.stride * set.triangles.size());
+    m.gnormal.resize(set.triangles.size());
+    const bool need_vertex_normals = set.shading == Shading::smooth;
+    if (need_vertex_normals) m.vertex_normal.assign(set.positions.size(), Vec3d{0, 0, 0});
+    for (std::size_t i = 0; i < set.triangles.size(); ++i) {
+      const auto& tri = set.triangles[i];
+      const Vec3d& a = set.positions[tri.v[0]];
+      const Vec3d& b = set.positions[tri.v[1]];
+      const Vec3d& c = set.positions[tri.v[2]];
+      k.prepare(Vec3<T>(a), Vec3<T>(b), Vec3<T>(c), m.pre.data() + i * m.stride);
+      const Vec3d n = cross(b - a, c - a);  // length = twice the area
+      const double len = length(n);
+      m.gnormal[i] = len > 0 ? n / len : Vec3d{0, 0, 0};
+      if (need_vertex_normals)
+        for (int v : tri.v) m.vertex_normal[v] += n;  // area-weighted
+    }
+    for (auto& n : m.vertex_normal) {
+      const double len = length(n);
+      if (len > 0) n = n / len;
+    }
+    Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    for (const auto& p : set.positions) {
+      lo = vmin(lo, p);
+      hi = vmax(hi, p);
+    }
+    m.bs_center = (lo + hi) * 0.5;
+    for (const auto& p : set.positions) m.bs_radius = std::max(m.bs_radius, length(p - m.bs_center));
+    return m;
+  }
+
+  template <class T>
+  const std::vector<PreparedMesh<T>>& meshes() const {
+    if constexpr (sizeof(T) == 4) return meshes_f; else return meshes_d;
+  }
+
+  // Closest hit at precision T. The ray arrives in double (shading is done in
+  // double); the kernels see it converted to T.
+  template <class T>
+  std::optional<SceneHit> closest(const Ray<double>& rd) const {
+    const Ray<T> r(rd);
+    SceneHit best;
+    best.t = std::numeric_limits<double>::infinity();
+    Ray<T> window = r;
+    auto consider = [&](double t, int obj, int prim, double b1, double b2) {
+      if (nearer(t, obj, prim, best)) {
+        best = {t, obj, prim, b1, b2};
+        window.tmax = T(t);
+      }
+    };
+    for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
+      const Object& o = scene.objects[oi];
+      switch (o.kind) {
+        case Object::Kind::sphere: {
+          if (auto h = sph_method->sphere<T>().hit(window, Vec3<T>(o.sphere.center), T(o.sphere.radius)))
+            consider(double(h->t), int(oi), 0, 0, 0);
+          break;
+        }
+        case Object::Kind::plane: {
+          if (auto h = pln_method->plane<T>().hit(window, Vec3<T>(o.plane.normal), T(o.plane.offset)))
+            consider(double(h->t), int(oi), 0, 0, 0);
+          break;
+        }
+        case Object::Kind::mesh: {
+          const auto& m = meshes<T>()[mesh_index[oi]];
+          if (opt.accel == Accel::sphere &&
+              !segment_meets_ball(Ray<double>{rd.o, rd.d, double(window.tmin), double(window.tmax)},
+                                  m.bs_center, m.bs_radius))
+            break;
+          const auto& k = tri_method->triangle<T>();
+          const std::size_t n = m.set->triangles.size();
+          for (std::size_t i = 0; i < n; ++i)
+            if (auto h = k.hit_pre(window, m.pre.data() + i * m.stride, opt.cull))
+              consider(double(h->t), int(oi), int(i), double(h->b1), double(h->b2));
+          break;
+        }
+      }
+    }
+    if (best.object < 0) return std::nullopt;
+    return best;
+  }
+
+  // Is anything in the ray's window? (shadow rays)
+  template <class T>
+  bool occluded(const Ray<T>& r) const {
+    for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
+      const Object& o = scene.objects[oi];
+      switch (o.kind) {
+        case Object::Kind::sphere:
+          if (sph_method->sphere<T>().any(r, Vec3<T>(o.sphere.center), T(o.sphere.radius))) return true;
+          break;
+        case Object::Kind::plane:
+          if (pln_method->plane<T>().any(r, Vec3<T>(o.plane.normal), T(o.plane.offset))) return true;
+          break;
+        case Object::Kind::mesh: {
+          const auto& m = meshes<T>()[mesh_index[oi]];
+          if (opt.accel == Accel::sphere &&
+              !segment_meets_ball(static_cast<Ray<double>>(r), m.bs_center, m.bs_radius))
+            break;
+          const auto& k = tri_method->triangle<T>();
+          const std::size_t n = m.set->triangles.size();
+          for (std::size_t i = 0; i < n; ++i)
+            if (k.any_pre(r, m.pre.data() + i * m.stride, opt.cull)) return true;
+          break;
+        }
+      }
+    }
+    return false;
+  }
+
+  std::optional<SceneHit> intersect(const Ray<double>& r) const {
+    return opt.use_double ? closest<double>(r) : closest<float>(r);
+  }
+
+  // The surface at a hit: point, geometric and shading normals, material,
+  // and the error bound of the point for the normal-offset strategy.
+  struct Surface {
+    Vec3d p, ng, n, p_error;
+    const Material* material;
+    bool has_uv = false;
+    double u = 0, v = 0;
+  };
+
+  Surface surface(const Ray<double>& ray, const SceneHit& h) const {
+    Surface s;
+    const Object& o = scene.objects[h.object];
+    s.p = ray.at(h.t);
+    switch (o.kind) {
+      case Object::Kind::sphere:
+        s.ng = s.n = (s.p - o.sphere.center) / o.sphere.radius;
+        s.p_error = sphere_point_error(s.p - o.sphere.center) + abs(o.sphere.center) * detail::gamma<double>(1);
+        s.material = &o.material;
+        break;
+      case Object::Kind::plane:
+        s.ng = s.n = o.plane.normal;
+        s.p_error = abs(s.p) * detail::gamma<double>(7);
+        s.material = &o.material;
+        break;
+      case Object::Kind::mesh: {
+        const TriangleSet& set = *o.mesh;
+        const MeshTriangle3& tri = set.triangles[h.prim];
+        const Vec3d& a = set.positions[tri.v[0]];
+        const Vec3d& b = set.positions[tri.v[1]];
+        const Vec3d& c = set.positions[tri.v[2]];
+        const double b0 = 1 - h.b1 - h.b2;
+        // The hit point from the barycentrics lies on the triangle's plane
+        // (o + t d may not, by t's rounding).
+        s.p = a * b0 + b * h.b1 + c * h.b2;
+        s.p_error = triangle_point_error(a, b, c, h.b1, h.b2);
+        const auto& gn = opt.use_double ? meshes_d[mesh_index[h.object]].gnormal[h.prim]
+                                        : meshes_f[mesh_index[h.object]].gnormal[h.prim];
+        s.ng = gn;
+        s.n = gn;
+        if (set.shading == Shading::smooth) {
+          Vec3d n;
+          if (tri.n[0] >= 0 && tri.n[1] >= 0 && tri.n[2] >= 0) {
+            // Document 002: n = normalize(nA + l2 (nB - nA) + l3 (nC - nA)).
+            const Vec3d& na = set.normals[tri.n[0]];
+            n = na + (set.normals[tri.n[1]] - na) * h.b1 + (set.normals[tri.n[2]] - na) * h.b2;
+          } else {
+            const auto& vn = opt.use_double ? meshes_d[mesh_index[h.object]].vertex_normal
+                                            : meshes_f[mesh_index[h.object]].vertex_normal;
+            n = vn[tri.v[0]] * b0 + vn[tri.v[1]] * h.b1 + vn[tri.v[2]] * h.b2;
+          }
+          const double len = length(n);
+          if (len > 0) s.n = n / len;
+        }
+        if (tri.t[0] >= 0 && tri.t[1] >= 0 && tri.t[2] >= 0) {
+          const auto& ta = set.uvs[tri.t[0]];
+          const auto& tb = set.uvs[tri.t[1]];
+          const auto& tc = set.uvs[tri.t[2]];
+          s.has_uv = true;
+          s.u = ta[0] + (tb[0] - ta[0]) * h.b1 + (tc[0] - ta[0]) * h.b2;
+          s.v = ta[1] + (tb[1] - ta[1]) * h.b1 + (tc[1] - ta[1]) * h.b2;
+        }
+        s.material = &set.materials[std::clamp(tri.material, 0, int(set.materials.size()) - 1)];
+        break;
+      }
+    }
+    return s;
+  }
+
+  Color pigment(const Surface& s) const { return s.material->color; }
+
+  bool shadowed(const Surface& s, const Vec3d& to_light, double dist) const {
+    if (opt.use_double) {
+      const Ray<double> r = spawn_ray<double>(opt.self_intersection, s.p, s.p_error, s.ng, to_light, true, dist);
+      return occluded<double>(r);
+    }
+    const Ray<float> r = spawn_ray<float>(opt.self_intersection, Vec3f(s.p), Vec3f(s.p_error), Vec3f(s.ng),
+                                          Vec3f(to_light), true, float(dist));
+    return occluded<float>(r);
+  }
+
+  Ray<double> reflected_ray(const Surface& s, const Vec3d& dir) const {
+    if (opt.use_double)
+      return spawn_ray<double>(opt.self_intersection, s.p, s.p_error, s.ng, dir, false, 0.0);
+    const Ray<float> r = spawn_ray<float>(opt.self_intersection, Vec3f(s.p), Vec3f(s.p_error), Vec3f(s.ng),
+                                          Vec3f(dir), false, 0.f);
+    return Ray<double>{Vec3d(r.o), dir, double(r.tmin), std::numeric_limits<double>::infinity()};
+  }
+
+  // POV-Ray's trace: level 1 for camera rays; beyond max_depth, black.
+  Color trace(const Ray<double>& ray, int level, double weight) const {
+    if (level > scene.max_depth) return {0, 0, 0};
+    const auto hit = intersect(ray);
+    if (!hit) return scene.background;
+    Surface s = surface(ray, *hit);
+    const Vec3d d = normalize(ray.d);
+    if (dot(s.n, d) > 0) s.n = -s.n;  // POV flips the normal to face the ray
+    const Material& m = *s.material;
+    const Color c = pigment(s);
+    Color out = mul(mul(c, m.ambient), scene.ambient_light);
+    const Vec3d refl_dir = d - s.n * (2 * dot(d, s.n));
+    for (const auto& light : scene.lights) {
+      const Vec3d lv = light.position - s.p;
+      const double dist = length(lv);
+      if (!(dist > 0)) continue;
+      const Vec3d l = lv / dist;
+      const double nl = dot(s.n, l);
+      if (nl < kMinCosIncidence) continue;
+      if (shadowed(s, l, dist)) continue;
+      out += mul(c, light.color) * (m.diffuse * nl);
+      if (m.phong > 0) {
+        const double rl = dot(refl_dir, l);
+        if (rl > 0) out += light.color * (m.phong * std::pow(rl, m.phong_size));
+      }
+    }
+    const double kr = max_component(m.reflection);
+    if (kr > 0 && weight * kr >= scene.adc_bailout) {
+      const Color r = trace(reflected_ray(s, refl_dir), level + 1, weight * kr);
+      out += mul(m.reflection, r);
+    }
+    return out;
+  }
+
+  Color pixel(int i, int j) const {
+    const int n = opt.samples_per_axis;
+    Color sum{0, 0, 0};
+    for (int sy = 0; sy < n; ++sy)
+      for (int sx = 0; sx < n; ++sx) {
+        Ray<double> r = camera.ray(i + (sx + 0.5) / n, j + (sy + 0.5) / n);
+        if (opt.self_intersection == SelfIntersection::pov) r.tmin = kPovMinIsectDepth;
+        sum += trace(r, 1, 1.0);
+      }
+    return sum / double(n * n);
+  }
+};
+
+Tracer::Tracer(const Scene& scene, const RenderOptions& options)
+    : impl_(std::make_unique<Impl>(scene, options)) {}
+Tracer::~Tracer() = default;
+
+Color Tracer::trace(const Ray<double>& ray) const { return impl_->trace(ray, 1, 1.0); }
+std::optional<SceneHit> Tracer::intersect(const Ray<double>& ray) const { return impl_->intersect(ray); }
+Color Tracer::pixel(int i, int j) const { return impl_->pixel(i, j); }
+
+Image Tracer::render() const {
+  const Scene& s = impl_->scene;
+  Image img(s.width, s.height);
+  constexpr int kTile = 32;
+  const int tiles_x = (s.width + kTile - 1) / kTile, tiles_y = (s.height + kTile - 1) / kTile;
+  const int tiles = tiles_x * tiles_y;
+  int threads = impl_->opt.threads > 0 ? impl_->opt.threads : int(std::thread::hardware_concurrency());
+  threads = std::clamp(threads, 1, std::max(1, tiles));
+  std::atomic<int> next{0}, done{0};
+  // Each pixel depends only on its own rays, so any thread may take any
+  // tile: the image is the same for every thread count.
+  auto worker = [&] {
+    for (int t; (t = next.fetch_add(1)) < tiles;) {
+      const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
+      for (int y = y0; y < std::min(y0 + kTile, s.height); ++y)
+        for (int x = x0; x < std::min(x0 + kTile, s.width); ++x) {
+          const Color c = impl_->pixel(x, y);
+          float* px = img.at(x, y);
+          px[0] = float(c.x);
+          px[1] = float(c.y);
+          px[2] = float(c.z);
+        }
+      done.fetch_add(1);
+    }
+  };
+  const bool show = impl_->opt.progress && isatty(STDERR_FILENO);
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
+  if (show) {
+    // The main thread reports progress while the others work, once the
+    // render has taken more than a moment.
+    pool.emplace_back(worker);
+    bool printed = false;
+    while (done.load() < tiles) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (secs > 0.5) {
+        std::fprintf(stderr, "\rrendering %dx%d: %3d%% (%.1f s)", s.width, s.height, 100 * done.load() / tiles, secs);
+        printed = true;
+      }
+    }
+    if (printed) std::fprintf(stderr, "\r\033[K");
+  } else {
+    worker();
+  }
+  for (auto& th : pool) th.join();
+  return img;
+}
+
+}  // namespace ra
