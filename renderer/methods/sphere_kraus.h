@@ -23,7 +23,7 @@ std::optional<SurfaceHit<T>> hit(const Ray<T>& r, const Vec3<T>& center, T radiu
   const Vec3<T> v = r.o - center;
   const T b = dot(v, dir);
   const T d2 = b * b - dot(v, v) + radius * radius;
-  if (d2 < T(0) || !(d2 == d2)) return std::nullopt;  // NaN: degenerate direction
+  if (!(d2 >= T(0))) return std::nullopt;  // also NaN, from a zero direction
   const T d = std::sqrt(d2);
   const T t1 = -b - d, t2 = -b + d;
   // The listing returns t1 if > epsilon5, else t2 if > epsilon5; the window
