@@ -8,6 +8,15 @@
 
 namespace {
 
+// Pads to `width` display columns: counts UTF-8 code points, not bytes, so
+// that sources such as "seeds/000 §2.1" keep the table aligned.
+std::string pad(const std::string& s, std::size_t width) {
+  std::size_t cols = 0;
+  for (unsigned char c : s)
+    if ((c & 0xC0) != 0x80) ++cols;
+  return s + std::string(cols < width ? width - cols : 1, ' ');
+}
+
 void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand("methods", "List the registered intersection methods");
   auto json = std::make_shared<bool>(false);
@@ -31,8 +40,8 @@ void setup(CLI::App& app) {
     for (const auto& m : ra::methods()) {
       char pre[32];
       std::snprintf(pre, sizeof pre, "%zu/%zu", m.precompute_bytes_float, m.precompute_bytes_double);
-      std::printf("%-18s %-8s %-9s %-46s %s\n", m.name.c_str(), std::string(ra::kind_name(m.kind)).c_str(),
-                  pre, m.source.c_str(), m.description.c_str());
+      std::printf("%-18s %-8s %-9s %s%s\n", m.name.c_str(), std::string(ra::kind_name(m.kind)).c_str(), pre,
+                  pad(m.source, 47).c_str(), m.description.c_str());
     }
   });
 }
