@@ -102,15 +102,15 @@ inline const char* parse_double(const char* p, const char* end, double& out, con
   if (p < end && *p == '+') ++p;
   auto [q, ec] = std::from_chars(p, end, out, std::chars_format::general);
   if (p < end && (*p == '+' || *p == '-') && tok != p) ec = std::errc::invalid_argument;  // "+-1"
+  if (q - tok > kMaxNumberChars && ec != std::errc::invalid_argument)
+    w.fail(line, "number too long (" + std::to_string(q - tok) + " characters, at most " +
+                     std::to_string(kMaxNumberChars) + ")");
   if (ec == std::errc::result_out_of_range)
     w.fail(line, "number out of range '" + token_text(tok, end) + "'");
   if (ec != std::errc()) {
     if (tok >= end || *tok == '#' || *tok == '\n') w.fail(line, "expected a number, found the end of the line");
     w.fail(line, "malformed number '" + token_text(tok, end) + "'");
   }
-  if (q - tok > kMaxNumberChars)
-    w.fail(line, "number too long (" + std::to_string(q - tok) + " characters, at most " +
-                     std::to_string(kMaxNumberChars) + ")");
   if (q < end && *q == '#' &&
       (starts_with_ci(q + 1, end, "IND") || starts_with_ci(q + 1, end, "INF") ||
        starts_with_ci(q + 1, end, "QNAN") || starts_with_ci(q + 1, end, "SNAN")))
