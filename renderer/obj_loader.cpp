@@ -236,9 +236,25 @@ struct ChunkParser {
   // One index of a face corner; count = elements defined so far.
   const char* parse_index(const char* p, const char* se, long count, const char* kind, long line, int& out) {
     const char* tok = p;
-    if (p < se && *p == '+') ++p;
+    const char* q = p;
     long long i = 0;
-    auto [q, ec] = std::from_chars(p, se, i);
+    std::errc ec{};
+    {  // fast path: up to 18 digits
+      bool neg = q < se && *q == '-';
+      q += neg;
+      const char* d = q;
+      while (q < se && unsigned(*q - '0') < 10 && q - d < 18) i = i * 10 + (*q++ - '0');
+      if (q == d || (q < se && unsigned(*q - '0') < 10)) {  // no digits, or more than 18
+        q = p;
+        i = 0;
+        if (p < se && *p == '+') ++p;
+        auto r = std::from_chars(p, se, i);
+        q = r.ptr;
+        ec = r.ec;
+      } else if (neg) {
+        i = -i;
+      }
+    }
     if (ec == std::errc::result_out_of_range) w.fail(line, std::string(kind) + " index out of range '" + token_text(tok, se) + "'");
     if (ec != std::errc() || (p != tok && *p == '-'))
       w.fail(line, std::string("malformed ") + kind + " index '" + token_text(tok, se) + "'");
@@ -264,7 +280,8 @@ struct ChunkParser {
     for (;;) {
       p = skip_ws(p, se);
       if (p >= se || *p == '#') break;
-      Corner k{-1, -1, -1};
+      poly.push_back({-1, -1, -1});  // parsed in place (no copy of a temporary)
+      Corner& k = poly.back();
       p = parse_index(p, se, nv, "vertex", line, k.v);
       if (p < se && *p == '/') {
         ++p;
@@ -278,7 +295,6 @@ struct ChunkParser {
       if (!at_separator(p, se)) w.fail(line, "malformed face vertex near '" + token_text(p, se) + "'");
       with_t += k.t >= 0;
       with_n += k.n >= 0;
-      poly.push_back(k);
     }
     const int n = int(poly.size());
     if (n < 3) w.fail(line, "face with " + std::to_string(n) + " vertices (at least 3 needed)");
@@ -537,7 +553,9 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
     };
     const size_t first = single ? 0 : m.triangles.size();
     if (!single) m.triangles.insert(m.triangles.end(), c.tris.begin(), c.tris.end());
-    for (size_t i = first; i < m.triangles.size(); ++i) {
+    // The first chunk's local tables are the global ones and it inherits
+    // nothing, so its triangles need no fixing.
+    for (size_t i = &c == &chunks[0] ? m.triangles.size() : first; i < m.triangles.size(); ++i) {
       auto& t = m.triangles[i];
       t.material = fix(t.material, mm, s_mat);
       t.group = fix(t.group, gm, s_group);
@@ -581,6 +599,9 @@ Mesh parse_chunks(std::string_view text, const std::string& name, const ObjOptio
   Mesh m;
   m.path = name;
   std::vector<Chunk> chunks = split(text, nthreads);
+  // The first chunk inherits nothing: its state starts as the file's.
+  chunks[0].cur_mat = chunks[0].cur_group = chunks[0].cur_object = -1;
+  chunks[0].cur_smooth = 0;
   run_parallel(chunks, count_chunk);
   long v = 0, vt = 0, vn = 0, line = 1, nf = 0;
   for (auto& c : chunks) {

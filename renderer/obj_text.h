@@ -94,13 +94,46 @@ inline bool starts_with_ci(const char* p, const char* end, const char* word) {
   return true;
 }
 
+// Clinger's fast path: [sign] digits [. digits] with at most 19 digits, a
+// mantissa <= 2^53 and at most 22 decimals is mantissa / 10^k, one correctly
+// rounded division of exact values, so the same double from_chars gives.
+// Returns false (p unchanged) for anything else (exponents, long numbers).
+inline bool fast_double(const char*& p, const char* end, double& out) {
+  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                      1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const char* s = p;
+  bool neg = false;
+  if (s < end && (*s == '-' || *s == '+')) neg = *s++ == '-';
+  unsigned long long mant = 0;
+  int digits = 0, frac = 0;
+  while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits;
+  if (s < end && *s == '.') {
+    ++s;
+    while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits, ++frac;
+  }
+  if (digits == 0 || digits > 19 || mant > (1ull << 53) || frac > 22) return false;
+  if (s < end && (*s == 'e' || *s == 'E')) return false;
+  const double v = frac ? double(mant) / kPow10[frac] : double(mant);
+  out = neg ? -v : v;
+  p = s;
+  return true;
+}
+
 // Parses one number at p (after whitespace): from_chars plus a leading '+'.
 // On success returns the pointer after it; errors name the token.
 inline const char* parse_double(const char* p, const char* end, double& out, const Where& w, long line) {
   p = skip_ws(p, end);
   const char* tok = p;
-  if (p < end && *p == '+') ++p;
-  auto [q, ec] = std::from_chars(p, end, out, std::chars_format::general);
+  const char* q = p;
+  std::errc ec{};
+  if (fast_double(q, end, out)) {
+    if (q >= end || (*q != '#' && at_separator(q, end))) return q;  // the common case
+  } else {
+    if (p < end && *p == '+') ++p;
+    auto r = std::from_chars(p, end, out, std::chars_format::general);
+    q = r.ptr;
+    ec = r.ec;
+  }
   if (p < end && (*p == '+' || *p == '-') && tok != p) ec = std::errc::invalid_argument;  // "+-1"
   if (q - tok > kMaxNumberChars && ec != std::errc::invalid_argument)
     w.fail(line, "number too long (" + std::to_string(q - tok) + " characters, at most " +
