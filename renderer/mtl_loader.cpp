@@ -14,6 +14,7 @@
 // - Statements before the first newmtl, unknown ones and `newmtl` without
 //   a name (Blender writes it; the material is named "") are warnings.
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "mesh.h"
@@ -164,7 +165,7 @@ struct MtlParser {
     }
     if (kw(k, p, "illum")) {
       const double v = scalar(p, se, line, "illum");
-      if (v != double(int(v)) || v < 0 || v > 1000) w.fail(line, "illum needs a non-negative integer");
+      if (!(v >= 0 && v <= 1000) || v != std::floor(v)) w.fail(line, "illum needs an integer 0..1000");
       m.illum = int(v);
       return;
     }

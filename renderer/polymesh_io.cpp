@@ -51,7 +51,11 @@ struct Tokens {
     if (p < e && *p == '+') ++p;
     auto [q, ec] = std::from_chars(p, e, v);
     if (ec != std::errc() || (q < e && *q != ' ' && *q != '\t' && *q != '\r' && *q != '\n'))
-      fail(std::string("malformed ") + what + " '" + std::string(b, size_t(std::min<ptrdiff_t>(e - b, 20))) + "'");
+    {
+      const char* te = b;
+      while (te < e && te - b < 20 && *te != ' ' && *te != '\t' && *te != '\r' && *te != '\n') ++te;
+      fail(std::string("malformed ") + what + " '" + std::string(b, te) + "'");
+    }
     p = q;
     return v;
   }
