@@ -1,0 +1,96 @@
+// PLY (ascii, binary little/big endian) and OFF readers, and the OBJ writer.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "errors.h"
+#include "mesh.h"
+#include "polymesh_io.h"
+
+namespace ra {
+namespace {
+
+// The unit square z=0 as one quad plus a triangle (0,0,0) (1,0,0) (0,0,1):
+// OBJ area 1 + 0.5.
+void expect_square(const PolyMesh& m) {
+  ASSERT_EQ(m.positions.size(), 5u);
+  EXPECT_EQ(m.positions[2], Vec3d(1, 1, 0));
+  EXPECT_EQ(m.positions[4], Vec3d(0, 0, 1));
+  ASSERT_EQ(m.faces(), 2u);
+  EXPECT_EQ(m.face_start, (std::vector<int>{0, 4, 7}));
+  EXPECT_EQ(m.indices, (std::vector<int>{0, 1, 2, 3, 0, 1, 4}));
+  const Mesh obj = parse_obj(to_obj_text(m, "test"), "c.obj");
+  EXPECT_EQ(obj.triangles.size(), 3u);
+  EXPECT_DOUBLE_EQ(obj.area(), 1.5);
+}
+
+const char* kHeader =
+    "element vertex 5\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+    "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+
+TEST(Ply, Ascii) {
+  expect_square(parse_ply(std::string("ply\nformat ascii 1.0\ncomment hi\n") + kHeader +
+                              "0 0 0 255\n1 0 0 0\n1 1 0 0\n0 1 0 0\n0 0 1 0\n4 0 1 2 3\n3 0 1 4\n",
+                          "a.ply"));
+}
+
+std::string binary_body(bool big) {
+  std::string b;
+  auto put = [&](const void* p, size_t n) {
+    std::string s(static_cast<const char*>(p), n);
+    if (big) std::reverse(s.begin(), s.end());
+    b += s;
+  };
+  const float v[5][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (auto& p : v) {
+    for (float c : p) put(&c, 4);
+    b += char(7);  // red
+  }
+  const std::vector<std::vector<int>> faces = {{0, 1, 2, 3}, {0, 1, 4}};
+  for (auto& f : faces) {
+    b += char(f.size());
+    for (int i : f) put(&i, 4);
+  }
+  return b;
+}
+
+TEST(Ply, BinaryLittleAndBigEndian) {
+  expect_square(parse_ply(std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + binary_body(false), "l.ply"));
+  expect_square(parse_ply(std::string("ply\nformat binary_big_endian 1.0\n") + kHeader + binary_body(true), "b.ply"));
+}
+
+TEST(Ply, Errors) {
+  EXPECT_THROW(parse_ply("plx\n", "x.ply"), InputError);
+  const std::string trunc = std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + binary_body(false).substr(0, 30);
+  try {
+    parse_ply(trunc, "t.ply");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.ply: byte"), std::string::npos) << e.what();
+  }
+  try {
+    parse_ply(std::string("ply\nformat ascii 1.0\n") + kHeader + "0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n0 0 1 1\n4 0 1 2 9\n3 0 1 4\n",
+              "r.ply");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "r.ply: face 0 has vertex index 9 out of range (5 vertices)");
+  }
+}
+
+TEST(Off, ReadsWithCommentsAndColours) {
+  expect_square(parse_off("OFF\n# a comment\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3 255 0 0\n3 0 1 4\n",
+                          "s.off"));
+  expect_square(parse_off("OFF 5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3\n3 0 1 4\n", "s.off"));
+}
+
+TEST(Off, Errors) {
+  try {
+    parse_off("OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 x\n", "e.off");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "e.off:6: malformed coordinate 'x'");
+  }
+}
+
+}  // namespace
+}  // namespace ra
