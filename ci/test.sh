@@ -1,7 +1,14 @@
 #!/usr/bin/env bash
 # Command 2 of the README (and what .ci/run runs): install what is missing,
-# build, and run the whole test suite through ctest. Idempotent.
+# build, fetch the mesh corpus into the cache, run the whole test suite
+# through ctest, then a 60-second libFuzzer run per parser. Idempotent.
 source "$(dirname "$0")/common.sh"
+
+step "fetching the mesh corpus into ${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus (ci/fetch-corpus.sh)"
+ci/fetch-corpus.sh "$RAYAUDIT"
 
 step "running the test suite (ctest --preset release)"
 ctest --preset release -j "$JOBS"
+
+step "fuzzing the OBJ and MTL parsers for ${FUZZ_SECONDS:-60} s each (ci/fuzz.sh)"
+ci/fuzz.sh
