@@ -74,16 +74,17 @@ template <class T> Vec3<T> ulp_offset(const Vec3<T>& p, const Vec3<T>& n) {
       r[i] = p[i] + float_scale * n[i];
       continue;
     }
+    const T pi = p[i];  // Vec3's const operator[] returns a value: copy to take its address
     if constexpr (sizeof(T) == 4) {
       const auto of = static_cast<std::int32_t>(T(256) * n[i]);
       std::int32_t bits;
-      std::memcpy(&bits, &p[i], 4);
+      std::memcpy(&bits, &pi, 4);
       bits += (p[i] < 0) ? -of : of;
       std::memcpy(&r[i], &bits, 4);
     } else {
       const auto of = static_cast<std::int64_t>(T(256) * T(536870912.0) * n[i]);
       std::int64_t bits;
-      std::memcpy(&bits, &p[i], 8);
+      std::memcpy(&bits, &pi, 8);
       bits += (p[i] < 0) ? -of : of;
       std::memcpy(&r[i], &bits, 8);
     }
