@@ -194,15 +194,16 @@ template <class T>
 void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
                  const std::vector<oracle::Answer>& ans, const std::vector<int>& cross, Stats& st) {
   const auto& f = fn<T>(s);
+  std::size_t pair = 0;  // index into ans, see judge()
   for (std::size_t pi = 0; pi < b.probes.size(); ++pi) {
     const Probe& p = b.probes[pi];
     const Ray<T> r = cr<T>(p.ray);
     int hits = 0;
-    for (int k = p.first; k < p.first + p.count; ++k) {
+    for (int k = p.first; k < p.first + p.count; ++k, ++pair) {
       const Tri& t = b.tris[std::size_t(k)];
       const auto h = f(r, cv<T>(t.a), cv<T>(t.b), cv<T>(t.c));
       hits += h.has_value();
-      book<T>(st, ans[std::size_t(k)], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
+      book<T>(st, ans[pair], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
     }
     if (p.count > 1) {
       ++st.groups;
@@ -276,12 +277,14 @@ std::vector<Task> plan(const std::vector<const Family*>& fams, long long rays) {
   return tasks;
 }
 
+// Exact answers per (probe, triangle) pair, probe after probe: probes may
+// share triangles (a closed mesh), so answers are indexed by pair, not triangle.
 std::vector<oracle::Answer> judge(const TriangleBatch& b) {
-  std::vector<oracle::Answer> ans(b.tris.size());
+  std::vector<oracle::Answer> ans;
   for (const Probe& p : b.probes)
     for (int k = p.first; k < p.first + p.count; ++k) {
       const Tri& t = b.tris[std::size_t(k)];
-      ans[std::size_t(k)] = oracle::triangle(p.ray, t.a, t.b, t.c);
+      ans.push_back(oracle::triangle(p.ray, t.a, t.b, t.c));
     }
   return ans;
 }
@@ -379,7 +382,11 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           std::vector<int> cross;
           if (!t.family->secondary) {
             ans = judge(b);
-            for (const Probe& pr : b.probes) cross.push_back(crossings(&ans[std::size_t(pr.first)], pr.count));
+            std::size_t pair = 0;
+            for (const Probe& pr : b.probes) {
+              cross.push_back(crossings(&ans[pair], pr.count));
+              pair += std::size_t(pr.count);
+            }
           }
           for (std::size_t si = 0; si < tris.size(); ++si) {
             if (tris[si].precision != p) continue;
