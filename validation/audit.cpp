@@ -181,18 +181,21 @@ template <class T> const SphereFn<T>& fn(const SphereSubject& s) {
   if constexpr (sizeof(T) == 4) return s.f32; else return s.f64;
 }
 
-// Number of distinct exact crossings of a group (distinct t of hit/boundary answers).
+// Number of distinct exact crossings of a group ahead of the origin
+// (distinct t > 0 of hit/boundary answers).
 int crossings(const oracle::Answer* a, int n) {
   std::vector<double> ts;
   for (int i = 0; i < n; ++i)
-    if (a[i].verdict == oracle::Verdict::hit || a[i].verdict == oracle::Verdict::boundary) ts.push_back(a[i].t);
+    if ((a[i].verdict == oracle::Verdict::hit || a[i].verdict == oracle::Verdict::boundary) && a[i].t > 0)
+      ts.push_back(a[i].t);
   std::sort(ts.begin(), ts.end());
   return int(std::unique(ts.begin(), ts.end()) - ts.begin());
 }
 
 template <class T>
 void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
-                 const std::vector<oracle::Answer>& ans, const std::vector<int>& cross, Stats& st) {
+                 const std::vector<oracle::Answer>& ans, const std::vector<int>& cross,
+                 const std::vector<char>& proper, Stats& st) {
   const auto& f = fn<T>(s);
   std::size_t pair = 0;  // index into ans, see judge()
   for (std::size_t pi = 0; pi < b.probes.size(); ++pi) {
@@ -206,9 +209,15 @@ void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
       book<T>(st, ans[pair], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
     }
     if (p.count > 1) {
-      ++st.groups;
-      if (cross[pi] > 0 && hits == 0) ++st.leaks;
-      if (hits > std::max(cross[pi], 1)) ++st.double_hits;
+      if (cross[pi] > 0 && hits > cross[pi]) ++st.double_hits;
+      // Leaks are judged on proper groups only (see group_is_proper), and
+      // only for crossings ahead of the origin: an origin on the surface
+      // (t = 0) is the secondary family's subject, and pbrt-style methods
+      // reject t <= their error bound on purpose.
+      if (proper[pi]) {
+        ++st.groups;
+        if (cross[pi] > 0 && hits == 0) ++st.leaks;
+      }
     }
   }
 }
@@ -380,11 +389,13 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           generate(*t.family, t.sweep, p, stream, t.count, b);
           std::vector<oracle::Answer> ans;
           std::vector<int> cross;
+          std::vector<char> proper;
           if (!t.family->secondary) {
             ans = judge(b);
             std::size_t pair = 0;
             for (const Probe& pr : b.probes) {
               cross.push_back(crossings(&ans[pair], pr.count));
+              proper.push_back(pr.closed || (pr.count > 1 && group_is_proper(&b.tris[std::size_t(pr.first)], pr.count, pr.ray.d)));
               pair += std::size_t(pr.count);
             }
           }
@@ -396,8 +407,8 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
               p == Precision::f32 ? eval_secondary<float>(tris[si], strategy, b, st)
                                   : eval_secondary<double>(tris[si], strategy, b, st);
             } else {
-              p == Precision::f32 ? eval_probes<float>(tris[si], b, ans, cross, st)
-                                  : eval_probes<double>(tris[si], b, ans, cross, st);
+              p == Precision::f32 ? eval_probes<float>(tris[si], b, ans, cross, proper, st)
+                                  : eval_probes<double>(tris[si], b, ans, cross, proper, st);
             }
             results.emplace_back(cell_index(si, fi, t.sweep), st);
           }

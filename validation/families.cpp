@@ -166,6 +166,23 @@ void add_single(TriangleBatch& b, const Tri& t, const Rayd& r) {
 
 Rayd aimed(const Vec3d& o, const Vec3d& target) { return {o, target - o}; }
 
+// True when every triangle faces direction d the same way, clearly (not
+// edge-on): then the group does not fold over itself seen along d, and a
+// line through a shared edge or vertex must meet one of them (what a
+// watertight method promises). Other groups are not judged for leaks.
+bool faces_alike(const std::vector<Tri>& tris, const Vec3d& d) {
+  int sign = 0;
+  for (const Tri& t : tris) {
+    const Vec3d n = cross(t.b - t.a, t.c - t.a);
+    const double nd = dot(n, d);
+    if (!(std::abs(nd) > 1e-6 * length(n) * length(d))) return false;
+    const int s = nd > 0 ? 1 : -1;
+    if (sign != 0 && s != sign) return false;
+    sign = s;
+  }
+  return true;
+}
+
 // A triangle in [-1,1]^3 and a ray from [-4,4]^3 aimed into its bounding box
 // grown by `spread` about its centre (spread 1: the box itself).
 void random_case(Rng& g, double spread, double scale, const Vec3d& offset, TriangleBatch& b) {
@@ -193,9 +210,14 @@ void edge_case(Rng& g, double offset, TriangleBatch& b) {
   const Vec3d r1 = m + u * h1 + w * (h1 * g.uniform(-0.5, 0.5));
   const Vec3d r2 = m - u * h2 + w * (h2 * g.uniform(-0.5, 0.5));
   const Vec3d aim = to_float(p + (q - p) * g.uniform(0.05, 0.95));
-  const Vec3d o = aim + (w * (g.below(2) ? 1.0 : -1.0) + g.in_cube(0.7)) * g.uniform(1, 3);
-  b.tris.push_back({p, q, r1});
-  b.tris.push_back({q, p, r2});
+  const Tri t1{p, q, r1}, t2{q, p, r2};
+  Vec3d o;
+  for (int tries = 0; tries < 64; ++tries) {
+    o = aim + (w * (g.below(2) ? 1.0 : -1.0) + g.in_cube(0.7)) * g.uniform(1, 3);
+    if (faces_alike({t1, t2}, aim - o)) break;
+  }
+  b.tris.push_back(t1);
+  b.tris.push_back(t2);
   b.probes.push_back({aimed(o, aim), int(b.tris.size()) - 2, 2});
 }
 
@@ -216,8 +238,13 @@ void vertex_case(Rng& g, double offset, TriangleBatch& b) {
   const int first = int(b.tris.size());
   for (int i = 0; i < k; ++i) b.tris.push_back({v, ring[i], ring[(i + 1) % k]});
   const double side = g.below(2) ? 1.0 : -1.0;
-  const Vec3d dir = normalize(e * side + (u * g.uniform(-1, 1) + w * g.uniform(-1, 1)) * 1.7);
-  const Vec3d o = v + dir * g.uniform(1, 3);
+  const std::vector<Tri> fan(b.tris.begin() + first, b.tris.end());
+  Vec3d o;
+  for (int tries = 0; tries < 64; ++tries) {
+    const Vec3d dir = normalize(e * side + (u * g.uniform(-1, 1) + w * g.uniform(-1, 1)) * 1.7);
+    o = v + dir * g.uniform(1, 3);
+    if (faces_alike(fan, v - o)) break;
+  }
   b.probes.push_back({aimed(o, v), first, k});
 }
 
@@ -316,7 +343,7 @@ void closed_mesh_cases(Rng& g, int sweep, Precision p, int count, TriangleBatch&
     } else {
       target = o + g.unit();
     }
-    b.probes.push_back({aimed(o, target), first, int(m.f.size())});
+    b.probes.push_back({aimed(o, target), first, int(m.f.size()), true});
   }
   (void)p;
 }
@@ -391,6 +418,10 @@ std::uint64_t stream_seed(std::uint64_t seed, const std::string& family, int swe
   Rng g{seed ^ h};
   g.s ^= (std::uint64_t(sweep) << 40) ^ std::uint64_t(chunk) * 0xD1B54A32D192ED03ull;
   return g.next();
+}
+
+bool group_is_proper(const Tri* tris, int count, const Vec3d& d) {
+  return faces_alike(std::vector<Tri>(tris, tris + count), d);
 }
 
 void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,

@@ -24,6 +24,9 @@ struct Probe {
   Rayd ray;
   int first = 0;
   int count = 1;
+  // A closed mesh around the origin: every ray must leave through it, so it
+  // is judged for leaks without the group_is_proper test.
+  bool closed = false;
 };
 
 struct TriangleBatch {
@@ -64,6 +67,10 @@ void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int
               TriangleBatch& out);
 void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,
               std::vector<SphereCase>& out);
+
+// A group judged for leaks: every triangle clearly faces the ray's direction
+// the same way (no fold seen along d, none edge-on or degenerate).
+bool group_is_proper(const Tri* tris, int count, const Vec3d& d);
 
 // The secondary family's sweep index = strategy * scales + scale index.
 int secondary_strategy(int sweep);
