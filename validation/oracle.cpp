@@ -77,40 +77,50 @@ int isign(const I& v) {
   return 2;
 }
 
+// What the interval filter settled.
+enum class Filtered {
+  decided,    // `out` is the answer (miss, coplanar, degenerate)
+  crossing,   // hit or boundary certain (out.verdict, out.zero_edges): only t is left
+  undecided,  // the exact path must redo everything
+};
+
 // Decides the verdicts that need no exact t (miss, coplanar, degenerate) when
-// the intervals are conclusive; returns false otherwise (including every hit,
-// whose t must be exact).
-bool filtered_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c,
-                       double lo, Answer& out) {
+// the intervals are conclusive, and certifies hits so the exact path computes
+// only t.
+Filtered filtered_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                           double lo, Answer& out) {
+  constexpr Filtered decided = Filtered::decided;
   CGAL::Protect_FPU_rounding<true> guard;
   const IV n = icross(isub(b, a), isub(c, a));
   const int nx = isign(n.x), ny = isign(n.y), nz = isign(n.z);
-  if (nx == 0 && ny == 0 && nz == 0) return out = make(Verdict::degenerate), true;
-  if (!(nx == 1 || nx == -1 || ny == 1 || ny == -1 || nz == 1 || nz == -1)) return false;
+  if (nx == 0 && ny == 0 && nz == 0) return out = make(Verdict::degenerate), decided;
+  if (!(nx == 1 || nx == -1 || ny == 1 || ny == -1 || nz == 1 || nz == -1)) return Filtered::undecided;
   const IV d = iv(r.d), ao = isub(a, r.o), bo = isub(b, r.o), co = isub(c, r.o);
   const I D = idot(n, d), N = idot(n, ao);
   const int sD = isign(D);
-  if (sD == 2) return false;
+  if (sD == 2) return Filtered::undecided;
   if (sD == 0) {
     const int sN = isign(N);
-    if (sN == 2) return false;
-    return out = make(sN == 0 ? Verdict::coplanar : Verdict::miss), true;
+    if (sN == 2) return Filtered::undecided;
+    return out = make(sN == 0 ? Verdict::coplanar : Verdict::miss), decided;
   }
   const int w[3] = {isign(idot(d, icross(ao, bo))), isign(idot(d, icross(bo, co))),
                     isign(idot(d, icross(co, ao)))};
   for (int s : w)
-    if (s == -sD) return out = make(Verdict::miss), true;  // the line passes outside
+    if (s == -sD) return out = make(Verdict::miss), decided;  // the line passes outside
   for (int s : w)
-    if (s == 2) return false;
+    if (s == 2) return Filtered::undecided;
   const int below = isign(N - I(lo) * D);
-  if (below == 2) return false;
-  if (below * sD < 0) return out = make(Verdict::miss), true;
+  if (below == 2) return Filtered::undecided;
+  if (below * sD < 0) return out = make(Verdict::miss), decided;
   if (std::isfinite(r.tmax)) {
     const int above = isign(I(r.tmax) * D - N);
-    if (above == 2) return false;
-    if (above * sD < 0) return out = make(Verdict::miss), true;
+    if (above == 2) return Filtered::undecided;
+    if (above * sD < 0) return out = make(Verdict::miss), decided;
   }
-  return false;
+  const int zeros = (w[0] == 0) + (w[1] == 0) + (w[2] == 0);
+  out = make(zeros ? Verdict::boundary : Verdict::hit, kNaN, zeros);
+  return Filtered::crossing;
 }
 
 // ----------------------------------------------------------------- exact ---
@@ -216,6 +226,22 @@ double round_ratio(Scratch& s, const Z& num, const Z& den) {
   return mpfr_get_d(s.f53, MPFR_RNDN);
 }
 
+// t = N / D exactly rounded, for a crossing the filter already certified.
+double exact_t(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  Scratch& s = scratch();
+  const int E = common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y,
+                                 b.z, c.x, c.y, c.z});
+  set_scaled(s.o, r.o, E), set_scaled(s.d, r.d, E);
+  set_scaled(s.a, a, E), set_scaled(s.b, b, E), set_scaled(s.c, c, E);
+  sub(s.e1, s.b, s.a), sub(s.e2, s.c, s.a);
+  cross(s.n, s.e1, s.e2, s.t0);
+  sub(s.ao, s.a, s.o);
+  dot(s.D, s.n, s.d, s.t0);
+  dot(s.N, s.n, s.ao, s.t0);
+  if (s.D.sign() < 0) mpz_neg(s.N.v, s.N.v), mpz_neg(s.D.v, s.D.v);
+  return round_ratio(s, s.N, s.D);
+}
+
 Answer exact_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c, double lo) {
   ++g_fallbacks;
   Scratch& s = scratch();
@@ -257,7 +283,11 @@ Answer triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   const double lo = std::max(r.tmin, 0.0);
   if (lo > r.tmax || std::isinf(lo)) return make(Verdict::miss);
   Answer out;
-  if (filtered_triangle(r, a, b, c, lo, out)) return out;
+  switch (filtered_triangle(r, a, b, c, lo, out)) {
+    case Filtered::decided: return out;
+    case Filtered::crossing: out.t = exact_t(r, a, b, c); return out;
+    case Filtered::undecided: break;
+  }
   return exact_triangle(r, a, b, c, lo);
 }
 
