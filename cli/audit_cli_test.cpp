@@ -137,7 +137,9 @@ TEST(AuditCli, ExportThenAuditAgreesOnEveryVerdict) {
     ASSERT_LT(i, j["cases"].size());
     const auto& c = j["cases"][i++];
     ASSERT_EQ(c["verdict"], verdict) << c["id"];
-    if (!t.empty()) ASSERT_EQ(c["t"].get<double>(), std::strtod(t.c_str(), nullptr)) << c["id"];
+    if (!t.empty()) {
+      ASSERT_EQ(c["t"].get<double>(), std::strtod(t.c_str(), nullptr)) << c["id"];
+    }
     ASSERT_EQ(c["id"], line.substr(0, line.find(','))) << "ids are the exported id column";
   }
   EXPECT_EQ(i, j["cases"].size());
