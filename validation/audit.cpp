@@ -1,0 +1,556 @@
+// The audit engine (issue 6): every subject x precision x family x sweep value,
+// graded against the exact oracle; statistics merge commutatively, so results never depend on threads.
+#include "audit.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "spawn.h"
+
+namespace ra::audit {
+
+// ---------------------------------------------------------- subjects ---
+TriangleSubject registry_triangle(const Method& m, Precision p) {
+  if (p == Precision::f32) {
+    auto k = m.tri_f.hit;
+    return triangle_subject<float>(m.name, [k](const Rayf& r, const Vec3f& a, const Vec3f& b,
+                                               const Vec3f& c) { return k(r, a, b, c, false); });
+  }
+  auto k = m.tri_d.hit;
+  return triangle_subject<double>(m.name, [k](const Rayd& r, const Vec3d& a, const Vec3d& b,
+                                              const Vec3d& c) { return k(r, a, b, c, false); });
+}
+
+SphereSubject registry_sphere(const Method& m, Precision p) {
+  if (p == Precision::f32) {
+    auto k = m.sph_f.hit;
+    return sphere_subject<float>(m.name, [k](const Rayf& r, const Vec3f& c, float rad) { return k(r, c, rad); });
+  }
+  auto k = m.sph_d.hit;
+  return sphere_subject<double>(m.name, [k](const Rayd& r, const Vec3d& c, double rad) { return k(r, c, rad); });
+}
+
+// ------------------------------------------------------------- stats ---
+namespace {
+
+// Distance in representable values of T between x and y (saturating).
+template <class T> std::uint64_t ulp_distance(T x, T y) {
+  using I = std::conditional_t<sizeof(T) == 4, std::int32_t, std::int64_t>;
+  I ix, iy;
+  std::memcpy(&ix, &x, sizeof x);
+  std::memcpy(&iy, &y, sizeof y);
+  // Map the sign-magnitude bit patterns to a monotonic signed line.
+  auto line = [](I i) -> long double {
+    return i < 0 ? -static_cast<long double>(i & std::numeric_limits<I>::max()) : static_cast<long double>(i);
+  };
+  const long double d = std::fabs(line(ix) - line(iy));
+  return d >= 1.8e19L ? std::numeric_limits<std::uint64_t>::max() : static_cast<std::uint64_t>(d);
+}
+
+int ulp_bin(std::uint64_t v) {
+  if (v < 64) return int(v);
+  const int e = 63 - __builtin_clzll(v);                       // >= 6
+  const int sub = int((v >> (e - 2)) & 3);                     // next two bits
+  return std::min(Stats::kUlpBins - 1, 64 + (e - 6) * 4 + sub);
+}
+std::uint64_t ulp_bin_low(int bin) {
+  if (bin < 64) return std::uint64_t(bin);
+  const int e = (bin - 64) / 4 + 6, sub = (bin - 64) % 4;
+  return (std::uint64_t(1) << e) + (std::uint64_t(sub) << (e - 2));
+}
+// Relative errors: bin 0 is exact; then 8 bins per octave from 2^-160.
+constexpr int kRelMinExp = -160;
+int rel_bin(double r) {
+  if (r <= 0) return 0;
+  const double l = std::log2(r);
+  const int b = 1 + int(std::floor((l - kRelMinExp) * 8));
+  return std::clamp(b, 1, Stats::kRelBins - 1);
+}
+double rel_bin_low(int bin) { return bin == 0 ? 0 : std::exp2(kRelMinExp + (bin - 1) / 8.0); }
+
+template <std::size_t N> int median_bin(const std::array<std::uint64_t, N>& h, std::uint64_t n) {
+  std::uint64_t acc = 0;
+  for (std::size_t i = 0; i < N; ++i)
+    if ((acc += h[i]) * 2 >= n) return int(i);
+  return int(N) - 1;
+}
+
+}  // namespace
+
+void Stats::merge(const Stats& o) {
+  tests += o.tests, true_hits += o.true_hits, false_hits += o.false_hits;
+  true_misses += o.true_misses, false_misses += o.false_misses;
+  boundary_hits += o.boundary_hits, boundary_misses += o.boundary_misses;
+  coplanar_hits += o.coplanar_hits, coplanar_misses += o.coplanar_misses;
+  degenerate_hits += o.degenerate_hits, degenerate_misses += o.degenerate_misses;
+  nan_inf += o.nan_inf, wrong_t += o.wrong_t;
+  groups += o.groups, leaks += o.leaks, double_hits += o.double_hits;
+  spawned += o.spawned, self_hits += o.self_hits;
+  t_samples += o.t_samples;
+  max_ulps = std::max(max_ulps, o.max_ulps);
+  max_rel = std::max(max_rel, o.max_rel);
+  for (int i = 0; i < kUlpBins; ++i) ulp_hist[i] += o.ulp_hist[i];
+  for (int i = 0; i < kRelBins; ++i) rel_hist[i] += o.rel_hist[i];
+}
+
+std::uint64_t Stats::median_ulps() const {
+  return t_samples ? ulp_bin_low(median_bin(ulp_hist, t_samples)) : 0;
+}
+double Stats::median_rel() const { return t_samples ? rel_bin_low(median_bin(rel_hist, t_samples)) : 0; }
+
+double Stats::badness() const {
+  return tests ? double(wrong() + leaks + double_hits + nan_inf) / double(tests) : 0;
+}
+
+nlohmann::json Stats::to_json() const {
+  nlohmann::json j = {{"tests", tests},
+                      {"wrong", wrong()},
+                      {"wrong_pct", tests ? 100.0 * double(wrong()) / double(tests) : 0.0},
+                      {"true_hits", true_hits},
+                      {"false_hits", false_hits},
+                      {"true_misses", true_misses},
+                      {"false_misses", false_misses},
+                      {"boundary_hits", boundary_hits},
+                      {"boundary_misses", boundary_misses},
+                      {"coplanar_hits", coplanar_hits},
+                      {"coplanar_misses", coplanar_misses},
+                      {"degenerate_hits", degenerate_hits},
+                      {"degenerate_misses", degenerate_misses},
+                      {"nan_inf", nan_inf},
+                      {"wrong_t", wrong_t},
+                      {"groups", groups},
+                      {"leaks", leaks},
+                      {"double_hits", double_hits},
+                      {"spawned", spawned},
+                      {"self_hits", self_hits},
+                      {"t_samples", t_samples},
+                      {"t_ulps_median", median_ulps()},
+                      {"t_ulps_max", max_ulps},
+                      {"t_rel_median", median_rel()},
+                      {"t_rel_max", max_rel}};
+  return j;
+}
+
+// -------------------------------------------------------- evaluation ---
+namespace {
+
+template <class T> bool finite_hit(const TriangleHit<T>& h) {
+  return std::isfinite(h.t) && std::isfinite(h.b1) && std::isfinite(h.b2);
+}
+template <class T> bool finite_hit(const SurfaceHit<T>& h) { return std::isfinite(h.t); }
+
+// Books one test: the exact answer against the subject's (hit, t).
+template <class T>
+void book(Stats& s, const oracle::Answer& a, bool hit, bool finite, T t) {
+  using oracle::Verdict;
+  ++s.tests;
+  if (hit && !finite) ++s.nan_inf;
+  switch (a.verdict) {
+    case Verdict::hit: ++(hit ? s.true_hits : s.false_misses); break;
+    case Verdict::miss: ++(hit ? s.false_hits : s.true_misses); break;
+    case Verdict::boundary: ++(hit ? s.boundary_hits : s.boundary_misses); break;
+    case Verdict::coplanar: ++(hit ? s.coplanar_hits : s.coplanar_misses); break;
+    case Verdict::degenerate: ++(hit ? s.degenerate_hits : s.degenerate_misses); break;
+  }
+  if (!hit || !std::isfinite(t) || !(a.verdict == Verdict::hit || a.verdict == Verdict::boundary))
+    return;
+  const std::uint64_t ulps = ulp_distance<T>(t, T(a.t));
+  const double rel = a.t != 0 ? std::abs(double(t) - a.t) / std::abs(a.t) : (t == 0 ? 0.0 : 1.0);
+  ++s.t_samples;
+  s.max_ulps = std::max(s.max_ulps, ulps);
+  s.max_rel = std::max(s.max_rel, rel);
+  ++s.ulp_hist[std::size_t(ulp_bin(ulps))];
+  ++s.rel_hist[std::size_t(rel_bin(rel))];
+  if (rel > kWrongTRelative) ++s.wrong_t;
+}
+
+template <class T> Vec3<T> cv(const Vec3d& v) { return Vec3<T>(v); }
+template <class T> Ray<T> cr(const Rayd& r) { return Ray<T>(r); }
+
+template <class T> const TriangleFn<T>& fn(const TriangleSubject& s) {
+  if constexpr (sizeof(T) == 4) return s.f32; else return s.f64;
+}
+template <class T> const SphereFn<T>& fn(const SphereSubject& s) {
+  if constexpr (sizeof(T) == 4) return s.f32; else return s.f64;
+}
+
+// Number of distinct exact crossings of a group ahead of the origin
+// (distinct t > 0 of hit/boundary answers).
+int crossings(const oracle::Answer* a, int n) {
+  std::vector<double> ts;
+  for (int i = 0; i < n; ++i)
+    if ((a[i].verdict == oracle::Verdict::hit || a[i].verdict == oracle::Verdict::boundary) && a[i].t > 0)
+      ts.push_back(a[i].t);
+  std::sort(ts.begin(), ts.end());
+  return int(std::unique(ts.begin(), ts.end()) - ts.begin());
+}
+
+template <class T>
+void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
+                 const std::vector<oracle::Answer>& ans, const std::vector<int>& cross,
+                 const std::vector<char>& proper, Stats& st) {
+  const auto& f = fn<T>(s);
+  std::size_t pair = 0;  // index into ans, see judge()
+  for (std::size_t pi = 0; pi < b.probes.size(); ++pi) {
+    const Probe& p = b.probes[pi];
+    const Ray<T> r = cr<T>(p.ray);
+    int hits = 0;
+    for (int k = p.first; k < p.first + p.count; ++k, ++pair) {
+      const Tri& t = b.tris[std::size_t(k)];
+      const auto h = f(r, cv<T>(t.a), cv<T>(t.b), cv<T>(t.c));
+      hits += h.has_value();
+      book<T>(st, ans[pair], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
+    }
+    if (p.count > 1) {
+      if (cross[pi] > 0 && hits > cross[pi]) ++st.double_hits;
+      // Leaks are judged on proper groups only (see group_is_proper), and
+      // only for crossings ahead of the origin: an origin on the surface
+      // (t = 0) is the secondary family's subject, and pbrt-style methods
+      // reject t <= their error bound on purpose.
+      if (proper[pi]) {
+        ++st.groups;
+        if (cross[pi] > 0 && hits == 0) ++st.leaks;
+      }
+    }
+  }
+}
+
+// Secondary rays from the subject's own hit point: a mirror reflection and a
+// shadow ray back toward the primary ray's origin (a light at the camera).
+template <class T>
+void eval_secondary(const TriangleSubject& s, SelfIntersection strategy, const TriangleBatch& b, Stats& st) {
+  const auto& f = fn<T>(s);
+  for (const Probe& p : b.probes) {
+    const Tri& tri = b.tris[std::size_t(p.first)];
+    const Vec3<T> A = cv<T>(tri.a), B = cv<T>(tri.b), C = cv<T>(tri.c);
+    const Ray<T> primary = cr<T>(p.ray);
+    const auto h = f(primary, A, B, C);
+    if (!h || !finite_hit(*h)) continue;
+    const Vec3<T> P = A * (T(1) - h->b1 - h->b2) + B * h->b1 + C * h->b2;
+    const Vec3<T> err = triangle_point_error(A, B, C, h->b1, h->b2);
+    const Vec3<T> n = normalize(cross(B - A, C - A));
+    const Vec3<T> d = normalize(primary.d);
+    const Vec3<T> refl = normalize(d - n * (T(2) * dot(d, n)));
+    const Vec3<T> to_light = primary.o - P;
+    const T light_dist = length(to_light);
+    const Ray<T> rays[2] = {spawn_ray(strategy, P, err, n, refl, false, T(0)),
+                            spawn_ray(strategy, P, err, n, to_light / light_dist, true, light_dist)};
+    for (const Ray<T>& r : rays) {
+      const oracle::Answer a = oracle::triangle(Rayd(r), Vec3d(A), Vec3d(B), Vec3d(C));
+      const auto h2 = f(r, A, B, C);
+      ++st.spawned;
+      st.self_hits += h2.has_value();
+      book<T>(st, a, h2.has_value(), h2 && finite_hit(*h2), h2 ? h2->t : T(0));
+    }
+  }
+}
+
+template <class T>
+void eval_spheres(const SphereSubject& s, const std::vector<SphereCase>& cs,
+                  const std::vector<oracle::Answer>& ans, Stats& st) {
+  const auto& f = fn<T>(s);
+  for (std::size_t i = 0; i < cs.size(); ++i) {
+    const auto h = f(cr<T>(cs[i].ray), cv<T>(cs[i].center), T(cs[i].radius));
+    book<T>(st, ans[i], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
+  }
+}
+
+constexpr int kChunk = 256;  // probes per task: fixed, so cases never depend on threads
+
+struct Task {
+  const Family* family;
+  int sweep;
+  int chunk;
+  int count;
+};
+
+int probes_per_sweep(const Family& f, int sweep, long long rays) {
+  const long long per = rays / (long long)f.sweep.size() / (f.secondary ? 2 : f.tris_per_probe(sweep));
+  return int(std::max(1LL, per));
+}
+
+std::vector<Task> plan(const std::vector<const Family*>& fams, long long rays) {
+  std::vector<Task> tasks;
+  for (const Family* f : fams)
+    for (int s = 0; s < int(f->sweep.size()); ++s) {
+      const int n = probes_per_sweep(*f, s, rays);
+      for (int c = 0; c * kChunk < n; ++c) tasks.push_back({f, s, c, std::min(kChunk, n - c * kChunk)});
+    }
+  return tasks;
+}
+
+// Exact answers per (probe, triangle) pair, probe after probe: probes may
+// share triangles (a closed mesh), so answers are indexed by pair, not triangle.
+std::vector<oracle::Answer> judge(const TriangleBatch& b) {
+  std::vector<oracle::Answer> ans;
+  for (const Probe& p : b.probes)
+    for (int k = p.first; k < p.first + p.count; ++k) {
+      const Tri& t = b.tris[std::size_t(k)];
+      ans.push_back(oracle::triangle(p.ray, t.a, t.b, t.c));
+    }
+  return ans;
+}
+
+}  // namespace
+
+std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
+                                   long long rays) {
+  std::vector<ProbeCase> out;
+  const int n = probes_per_sweep(f, sweep, rays);
+  for (int c = 0; c * kChunk < n; ++c) {
+    TriangleBatch b;
+    generate(f, sweep, p, stream_seed(seed, f.name, sweep, c), std::min(kChunk, n - c * kChunk), b);
+    for (const Probe& pr : b.probes) {
+      ProbeCase pc{pr.ray, {}, {}};
+      for (int k = pr.first; k < pr.first + pr.count; ++k) {
+        const Tri& t = b.tris[std::size_t(k)];
+        pc.tris.push_back(t);
+        pc.answers.push_back(oracle::triangle(pr.ray, t.a, t.b, t.c));
+      }
+      out.push_back(std::move(pc));
+    }
+  }
+  return out;
+}
+
+std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
+                                     long long rays) {
+  std::vector<SphereCase> out;
+  const int n = probes_per_sweep(f, sweep, rays);
+  for (int c = 0; c * kChunk < n; ++c)
+    generate(f, sweep, p, stream_seed(seed, f.name, sweep, c), std::min(kChunk, n - c * kChunk), out);
+  return out;
+}
+
+Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres,
+           const Options& opt) {
+  Report rep;
+  rep.seed = opt.seed;
+  rep.rays = opt.rays;
+  for (const auto& s : tris) rep.subjects.push_back(s.name()), rep.kinds.push_back("triangle");
+  for (const auto& s : spheres) rep.subjects.push_back(s.name()), rep.kinds.push_back("sphere");
+
+  std::vector<const Family*> fams;
+  for (const Family& f : families()) {
+    const bool wanted = opt.families.empty() ||
+                        std::find(opt.families.begin(), opt.families.end(), f.name) != opt.families.end();
+    const bool has_subjects = f.kind == Kind::triangle ? !tris.empty() : !spheres.empty();
+    if (wanted && has_subjects) fams.push_back(&f);
+  }
+  // Cells: subject-major; index of (subject, family, sweep) computed below.
+  std::vector<std::size_t> fam_base;  // first cell offset of each family within a subject
+  std::size_t per_subject_tri = 0, per_subject_sph = 0;
+  for (const Family* f : fams) {
+    std::size_t& n = f->kind == Kind::triangle ? per_subject_tri : per_subject_sph;
+    fam_base.push_back(n);
+    n += f->sweep.size();
+  }
+  auto cell_index = [&](std::size_t subject, std::size_t fam, int sweep) {
+    if (subject < tris.size()) return subject * per_subject_tri + fam_base[fam] + std::size_t(sweep);
+    return tris.size() * per_subject_tri + (subject - tris.size()) * per_subject_sph + fam_base[fam] +
+           std::size_t(sweep);
+  };
+  rep.cells.resize(tris.size() * per_subject_tri + spheres.size() * per_subject_sph);
+  for (std::size_t s = 0; s < rep.subjects.size(); ++s)
+    for (std::size_t fi = 0; fi < fams.size(); ++fi) {
+      const bool tri_family = fams[fi]->kind == Kind::triangle;
+      if (tri_family != (s < tris.size())) continue;
+      for (int w = 0; w < int(fams[fi]->sweep.size()); ++w)
+        rep.cells[cell_index(s, fi, w)] = {s, fams[fi]->name, w, fams[fi]->sweep[std::size_t(w)], {}};
+    }
+
+  const std::vector<Task> tasks = plan(fams, opt.rays);
+  std::atomic<std::size_t> next{0}, done{0};
+  std::mutex mu;
+  auto family_index = [&](const Family* f) {
+    return std::size_t(std::find(fams.begin(), fams.end(), f) - fams.begin());
+  };
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t ti = next++;
+      if (ti >= tasks.size()) return;
+      const Task& t = tasks[ti];
+      const std::size_t fi = family_index(t.family);
+      const std::uint64_t stream = stream_seed(opt.seed, t.family->name, t.sweep, t.chunk);
+      std::vector<std::pair<std::size_t, Stats>> results;
+      for (Precision p : {Precision::f32, Precision::f64}) {
+        if (t.family->kind == Kind::triangle) {
+          bool any = false;
+          for (const auto& s : tris) any |= s.precision == p;
+          if (!any) continue;
+          TriangleBatch b;
+          generate(*t.family, t.sweep, p, stream, t.count, b);
+          std::vector<oracle::Answer> ans;
+          std::vector<int> cross;
+          std::vector<char> proper;
+          if (!t.family->secondary) {
+            ans = judge(b);
+            std::size_t pair = 0;
+            for (const Probe& pr : b.probes) {
+              cross.push_back(crossings(&ans[pair], pr.count));
+              proper.push_back(pr.closed || (pr.count > 1 && group_is_proper(&b.tris[std::size_t(pr.first)], pr.count, pr.ray.d)));
+              pair += std::size_t(pr.count);
+            }
+          }
+          for (std::size_t si = 0; si < tris.size(); ++si) {
+            if (tris[si].precision != p) continue;
+            Stats st;
+            if (t.family->secondary) {
+              const auto strategy = SelfIntersection(secondary_strategy(t.sweep));
+              p == Precision::f32 ? eval_secondary<float>(tris[si], strategy, b, st)
+                                  : eval_secondary<double>(tris[si], strategy, b, st);
+            } else {
+              p == Precision::f32 ? eval_probes<float>(tris[si], b, ans, cross, proper, st)
+                                  : eval_probes<double>(tris[si], b, ans, cross, proper, st);
+            }
+            results.emplace_back(cell_index(si, fi, t.sweep), st);
+          }
+        } else {
+          bool any = false;
+          for (const auto& s : spheres) any |= s.precision == p;
+          if (!any) continue;
+          std::vector<SphereCase> cs;
+          generate(*t.family, t.sweep, p, stream, t.count, cs);
+          std::vector<oracle::Answer> ans;
+          for (const auto& c : cs) ans.push_back(oracle::sphere(c.ray, c.center, c.radius));
+          for (std::size_t si = 0; si < spheres.size(); ++si) {
+            if (spheres[si].precision != p) continue;
+            Stats st;
+            p == Precision::f32 ? eval_spheres<float>(spheres[si], cs, ans, st)
+                                : eval_spheres<double>(spheres[si], cs, ans, st);
+            results.emplace_back(cell_index(tris.size() + si, fi, t.sweep), st);
+          }
+        }
+      }
+      std::lock_guard<std::mutex> lock(mu);
+      for (auto& [ci, st] : results) rep.cells[ci].stats.merge(st);
+      ++done;
+      if (opt.progress) opt.progress(done, tasks.size());
+    }
+  };
+  const int n = opt.threads > 0 ? opt.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (int i = 1; i < n; ++i) pool.emplace_back(worker);
+  worker();
+  for (auto& th : pool) th.join();
+  return rep;
+}
+
+// ------------------------------------------------------------ report ---
+Stats Report::total(std::size_t subject) const {
+  Stats s;
+  for (const Cell& c : cells)
+    if (c.subject == subject) s.merge(c.stats);
+  return s;
+}
+
+const Cell* Report::worst(std::size_t subject) const {
+  const Cell* w = nullptr;
+  for (const Cell& c : cells)
+    if (c.subject == subject && c.stats.badness() > 0 && (!w || c.stats.badness() > w->stats.badness()))
+      w = &c;
+  return w;
+}
+
+nlohmann::json Report::to_json() const {
+  nlohmann::json subs = nlohmann::json::array(), cs = nlohmann::json::array();
+  for (std::size_t i = 0; i < subjects.size(); ++i) {
+    const Cell* w = worst(i);
+    const auto slash = subjects[i].rfind('/');
+    subs.push_back({{"name", subjects[i]},
+                    {"method", subjects[i].substr(0, slash)},
+                    {"precision", subjects[i].substr(slash + 1)},
+                    {"kind", kinds[i]},
+                    {"totals", total(i).to_json()},
+                    {"worst", w ? nlohmann::json{{"family", w->family}, {"sweep", w->sweep_label},
+                                                 {"badness", w->stats.badness()}}
+                                : nlohmann::json(nullptr)}});
+  }
+  for (const Cell& c : cells) {
+    const Family* f = find_family(c.family);
+    cs.push_back({{"subject", subjects[c.subject]},
+                  {"family", c.family},
+                  {"param", f ? f->param : ""},
+                  {"sweep", c.sweep_label},
+                  {"stats", c.stats.to_json()}});
+  }
+  return {{"seed", seed},
+          {"rays_per_family", rays},
+          {"semantics",
+           "ray = {o + t d : max(tmin,0) <= t <= tmax}; closed triangle; inputs exact as given "
+           "(float cases rounded to float before method and oracle); wrong = false hits + false "
+           "misses + hits with relative t error > 1e-2; boundary/coplanar/degenerate answers are "
+           "counted apart, never wrong"},
+          {"subjects", subs},
+          {"cells", cs}};
+}
+
+namespace {
+std::string fmt(const char* f, ...) __attribute__((format(printf, 1, 2)));
+std::string fmt(const char* f, ...) {
+  char buf[512];
+  va_list ap;
+  va_start(ap, f);
+  std::vsnprintf(buf, sizeof buf, f, ap);
+  va_end(ap);
+  return buf;
+}
+std::string count(std::uint64_t v) { return v ? std::to_string(v) : "-"; }
+}  // namespace
+
+std::string Report::summary_table() const {
+  std::string out = fmt("%-24s %10s %8s %8s %8s %7s %7s %7s %5s %7s %12s  %s\n", "METHOD/PRECISION",
+                        "TESTS", "WRONG%", "F.HITS", "F.MISS", "BAD-T", "LEAKS", "DOUBLE", "NaN",
+                        "SELF%", "T-ULPS md/max", "WORST (family@sweep: bad%)");
+  for (std::size_t i = 0; i < subjects.size(); ++i) {
+    const Stats s = total(i);
+    const Cell* w = worst(i);
+    std::string ulps = s.t_samples ? fmt("%llu/%s", (unsigned long long)s.median_ulps(),
+                                         s.max_ulps > 99999999 ? fmt("%.1e", double(s.max_ulps)).c_str()
+                                                               : std::to_string(s.max_ulps).c_str())
+                                   : "-";
+    out += fmt("%-24s %10llu %8.4f %8s %8s %7s %7s %7s %5s %7s %12s  %s\n", subjects[i].c_str(),
+               (unsigned long long)s.tests, s.tests ? 100.0 * double(s.wrong()) / double(s.tests) : 0.0,
+               count(s.false_hits).c_str(), count(s.false_misses).c_str(), count(s.wrong_t).c_str(),
+               count(s.leaks).c_str(), count(s.double_hits).c_str(), count(s.nan_inf).c_str(),
+               s.spawned ? fmt("%.2f", 100.0 * double(s.self_hits) / double(s.spawned)).c_str() : "-",
+               ulps.c_str(),
+               w ? fmt("%s@%s: %.3g%%", w->family.c_str(), w->sweep_label.c_str(), 100 * w->stats.badness()).c_str()
+                 : "none");
+  }
+  out +=
+      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = right hit, t off by > 1%; "
+      "LEAKS = edge/vertex/mesh rays the exact answer hits and the method misses entirely;\n"
+      "DOUBLE = more hits than exact crossings; SELF% = spawned secondary rays re-hitting their "
+      "triangle; boundary/coplanar/degenerate cases are in the JSON, never counted wrong.\n";
+  return out;
+}
+
+std::string Report::to_csv() const {
+  std::ostringstream os;
+  os << "method,precision,family,sweep,tests,wrong,false_hits,false_misses,wrong_t,boundary_hits,"
+        "boundary_misses,coplanar_hits,coplanar_misses,degenerate_hits,degenerate_misses,nan_inf,"
+        "groups,leaks,double_hits,spawned,self_hits,t_ulps_median,t_ulps_max,t_rel_median,t_rel_max\n";
+  for (const Cell& c : cells) {
+    const Stats& s = c.stats;
+    const std::string& n = subjects[c.subject];
+    const auto slash = n.rfind('/');
+    os << n.substr(0, slash) << ',' << n.substr(slash + 1) << ',' << c.family << ',' << c.sweep_label
+       << ',' << s.tests << ',' << s.wrong() << ',' << s.false_hits << ',' << s.false_misses << ','
+       << s.wrong_t << ',' << s.boundary_hits << ',' << s.boundary_misses << ',' << s.coplanar_hits
+       << ',' << s.coplanar_misses << ',' << s.degenerate_hits << ',' << s.degenerate_misses << ','
+       << s.nan_inf << ',' << s.groups << ',' << s.leaks << ',' << s.double_hits << ',' << s.spawned
+       << ',' << s.self_hits << ',' << s.median_ulps() << ',' << s.max_ulps << ','
+       << fmt("%.6g", s.median_rel()) << ',' << fmt("%.6g", s.max_rel) << '\n';
+  }
+  return os.str();
+}
+
+}  // namespace ra::audit

@@ -1,0 +1,154 @@
+// The audit engine and its C++ API: grades intersectors (the registry's or a
+// user's own callable) against the exact oracle over the case families.
+//
+// Use from your own code (link rayaudit::validation):
+//   auto s = ra::audit::triangle_subject<float>("mine", [](const ra::Rayf& r,
+//       const ra::Vec3f& a, const ra::Vec3f& b, const ra::Vec3f& c)
+//       -> std::optional<ra::TriangleHit<float>> { ... });
+//   ra::audit::Report rep = ra::audit::run({s}, {}, {});
+//   rep.total(0).leaks, rep.summary_table(), rep.to_json() ...
+// GoogleTest assertions over it are in audit_gtest.h.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "families.h"
+#include "hit.h"
+#include "oracle.h"
+#include "registry.h"
+
+namespace ra::audit {
+
+template <class T>
+using TriangleFn = std::function<std::optional<TriangleHit<T>>(const Ray<T>&, const Vec3<T>&,
+                                                               const Vec3<T>&, const Vec3<T>&)>;
+template <class T>
+using SphereFn = std::function<std::optional<SurfaceHit<T>>(const Ray<T>&, const Vec3<T>&, T)>;
+
+// An intersector under audit at one precision (only the matching callable is set).
+struct TriangleSubject {
+  std::string method;
+  Precision precision = Precision::f64;
+  TriangleFn<float> f32;
+  TriangleFn<double> f64;
+  std::string name() const { return method + "/" + precision_name(precision); }
+};
+struct SphereSubject {
+  std::string method;
+  Precision precision = Precision::f64;
+  SphereFn<float> f32;
+  SphereFn<double> f64;
+  std::string name() const { return method + "/" + precision_name(precision); }
+};
+
+template <class T, class F>
+TriangleSubject triangle_subject(std::string method, F&& f) {
+  TriangleSubject s;
+  s.method = std::move(method);
+  if constexpr (sizeof(T) == sizeof(float)) s.precision = Precision::f32, s.f32 = std::forward<F>(f);
+  else s.precision = Precision::f64, s.f64 = std::forward<F>(f);
+  return s;
+}
+template <class T, class F>
+SphereSubject sphere_subject(std::string method, F&& f) {
+  SphereSubject s;
+  s.method = std::move(method);
+  if constexpr (sizeof(T) == sizeof(float)) s.precision = Precision::f32, s.f32 = std::forward<F>(f);
+  else s.precision = Precision::f64, s.f64 = std::forward<F>(f);
+  return s;
+}
+
+// A registered method at one precision (two-sided: cull = false).
+TriangleSubject registry_triangle(const Method& m, Precision p);
+SphereSubject registry_sphere(const Method& m, Precision p);
+
+// A rounded relative t error above this is a wrong t (the hit is reported at
+// another point of the surface, e.g. a far sphere root), not a rounding error.
+inline constexpr double kWrongTRelative = 1e-2;
+
+// Counts for one subject over a set of cases.
+struct Stats {
+  // Per ray/primitive test, by exact verdict and the subject's answer.
+  std::uint64_t tests = 0, true_hits = 0, false_hits = 0, true_misses = 0, false_misses = 0,
+                boundary_hits = 0, boundary_misses = 0, coplanar_hits = 0, coplanar_misses = 0,
+                degenerate_hits = 0, degenerate_misses = 0;
+  std::uint64_t nan_inf = 0;  // a reported hit with a NaN or infinite t, b1 or b2
+  std::uint64_t wrong_t = 0;  // a right hit whose t is off by more than kWrongTRelative
+  // Per group (edge pair, vertex fan, closed mesh): the exact answer meets
+  // the group but the subject hits none of it (leak), or the subject reports
+  // more hits than the ray has distinct exact crossings (double hit).
+  std::uint64_t groups = 0, leaks = 0, double_hits = 0;
+  // Secondary rays: spawned, and how many hit the triangle they left.
+  std::uint64_t spawned = 0, self_hits = 0;
+  // t error of right hits: ulps in the subject's precision and relative.
+  static constexpr int kUlpBins = 320, kRelBins = 700;
+  std::uint64_t t_samples = 0, max_ulps = 0;
+  double max_rel = 0;
+  std::array<std::uint64_t, kUlpBins> ulp_hist{};
+  std::array<std::uint64_t, kRelBins> rel_hist{};
+
+  void merge(const Stats& o);
+  std::uint64_t wrong() const { return false_hits + false_misses + wrong_t; }
+  // Median ulps is exact below 64 ulps, within 1/4 octave above; median
+  // relative error within 1/8 octave (both report the bin's lower bound).
+  std::uint64_t median_ulps() const;
+  double median_rel() const;
+  // (wrong + leaks + double hits + NaN) per test: what "worst" ranks by.
+  double badness() const;
+  nlohmann::json to_json() const;
+};
+
+struct Options {
+  std::vector<std::string> families;  // empty: every family of the subjects' kinds
+  long long rays = 20000;             // ray/primitive tests per family per subject
+  std::uint64_t seed = 1;
+  int threads = 0;                    // 0: all hardware threads
+  std::function<void(std::size_t done, std::size_t total)> progress;  // from any thread, serialised
+};
+
+struct Cell {
+  std::size_t subject;  // index into Report::subjects
+  std::string family;
+  int sweep;
+  std::string sweep_label;
+  Stats stats;
+};
+
+struct Report {
+  std::uint64_t seed = 0;
+  long long rays = 0;
+  std::vector<std::string> subjects;  // "method/precision", triangles then spheres
+  std::vector<std::string> kinds;     // "triangle" / "sphere", per subject
+  std::vector<Cell> cells;            // subject-major, families and sweeps in order
+
+  Stats total(std::size_t subject) const;
+  const Cell* worst(std::size_t subject) const;  // nullptr when nothing went wrong
+  nlohmann::json to_json() const;
+  std::string summary_table() const;
+  std::string to_csv() const;
+};
+
+// Runs every subject over the chosen families (triangle subjects on triangle
+// families, sphere subjects on sphere families). Deterministic for any
+// thread count: cases depend only on (seed, family, sweep, chunk).
+Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres,
+           const Options& opt);
+
+// Every probe of a family with its exact answers, as the audit sees them
+// (for the export and for tests that check the families themselves).
+struct ProbeCase {
+  Rayd ray;
+  std::vector<Tri> tris;
+  std::vector<oracle::Answer> answers;
+};
+std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
+                                   long long rays);
+std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
+                                     long long rays);
+
+}  // namespace ra::audit

@@ -1,0 +1,143 @@
+// Reading user cases and writing generated cases as CSV (see cases_csv.h);
+// numbers go through std::strtod both ways (%a on output), so the round trip is exact.
+#include "cases_csv.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include "audit.h"
+#include "errors.h"
+
+namespace ra::audit {
+
+namespace {
+
+const char* const kColumns[15] = {"ox", "oy", "oz", "dx", "dy", "dz", "ax", "ay",
+                                  "az", "bx", "by", "bz", "cx", "cy", "cz"};
+
+std::vector<std::string> split_fields(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char ch : line) {
+    if (ch == ',') out.push_back(cur), cur.clear();
+    else cur += ch;
+  }
+  out.push_back(cur);
+  for (auto& f : out) {
+    const auto b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
+    f = b == std::string::npos ? "" : f.substr(b, e - b + 1);
+  }
+  return out;
+}
+
+// The whole field must be one number (decimal or hex float).
+bool parse_double(const std::string& s, double& out) {
+  if (s.empty()) return false;
+  errno = 0;
+  char* end = nullptr;
+  out = std::strtod(s.c_str(), &end);
+  // Underflow to a subnormal is fine (an exported %a may be subnormal); overflow is not.
+  return end == s.c_str() + s.size() && !(errno == ERANGE && std::isinf(out));
+}
+
+std::string hex(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%a", x);
+  return buf;
+}
+
+}  // namespace
+
+std::vector<UserCase> read_cases_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(located(path, 0, "cannot open the cases file"));
+  std::string line;
+  long lineno = 0;
+  std::vector<std::string> header;
+  while (header.empty() && std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
+  }
+  if (header.empty()) throw InputError(located(path, lineno, "empty file: expected a header line"));
+  int col[15];
+  int id_col = -1;
+  for (int k = 0; k < 15; ++k) {
+    col[k] = -1;
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (header[i] == kColumns[k]) col[k] = int(i);
+    if (col[k] < 0)
+      throw InputError(located(path, lineno, std::string("missing column '") + kColumns[k] +
+                                                 "' in the header (need ox,oy,oz,dx,dy,dz,ax,...,cz)"));
+  }
+  for (std::size_t i = 0; i < header.size(); ++i)
+    if (header[i] == "id") id_col = int(i);
+
+  std::vector<UserCase> cases;
+  long row = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    ++row;
+    const auto f = split_fields(line);
+    if (f.size() != header.size())
+      throw InputError(located(path, lineno, "expected " + std::to_string(header.size()) +
+                                                 " fields as in the header, found " + std::to_string(f.size())));
+    double v[15];
+    for (int k = 0; k < 15; ++k)
+      if (!parse_double(f[std::size_t(col[k])], v[k]))
+        throw InputError(located(path, lineno, std::string("column '") + kColumns[k] + "': '" +
+                                                   f[std::size_t(col[k])] + "' is not a number"));
+    UserCase c;
+    c.id_is_row = id_col < 0;
+    c.id = id_col < 0 ? std::to_string(row) : f[std::size_t(id_col)];
+    c.ray = Rayd{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+    c.tri = {{v[6], v[7], v[8]}, {v[9], v[10], v[11]}, {v[12], v[13], v[14]}};
+    cases.push_back(c);
+  }
+  return cases;
+}
+
+std::string cases_csv(const std::vector<ExportRow>& rows) {
+  // Appends piece by piece (GCC 12 warns falsely on `"," + std::string`).
+  std::string out = "id,family,sweep";
+  for (const char* c : kColumns) out.append(",").append(c);
+  out.append(",verdict,t\n");
+  for (const ExportRow& r : rows) {
+    out.append(r.id).append(",").append(r.family).append(",").append(r.sweep);
+    const double v[15] = {r.ray.o.x, r.ray.o.y, r.ray.o.z, r.ray.d.x, r.ray.d.y, r.ray.d.z,
+                          r.tri.a.x, r.tri.a.y, r.tri.a.z, r.tri.b.x, r.tri.b.y, r.tri.b.z,
+                          r.tri.c.x, r.tri.c.y, r.tri.c.z};
+    for (double x : v) out.append(",").append(hex(x));
+    out.append(",").append(oracle::verdict_name(r.answer.verdict)).append(",");
+    if (std::isfinite(r.answer.t)) out.append(hex(r.answer.t));
+    out.append("\n");
+  }
+  return out;
+}
+
+std::vector<ExportRow> export_rows(const std::vector<std::string>& fams, Precision p,
+                                   std::uint64_t seed, long long rays) {
+  std::vector<ExportRow> rows;
+  for (const Family& f : families()) {
+    if (f.kind != Kind::triangle || f.secondary) continue;
+    if (!fams.empty() && std::find(fams.begin(), fams.end(), f.name) == fams.end()) continue;
+    for (int s = 0; s < int(f.sweep.size()); ++s) {
+      const auto cases = probe_cases(f, s, p, seed, rays);
+      for (std::size_t i = 0; i < cases.size(); ++i)
+        for (std::size_t k = 0; k < cases[i].tris.size(); ++k)
+          rows.push_back({f.name + ":" + f.sweep[std::size_t(s)] + ":" + std::to_string(i) + ":" +
+                              std::to_string(k),
+                          f.name, f.sweep[std::size_t(s)], cases[i].ray, cases[i].tris[k],
+                          cases[i].answers[k]});
+    }
+  }
+  return rows;
+}
+
+}  // namespace ra::audit

@@ -1,0 +1,43 @@
+// User-supplied ray/triangle cases as CSV (`rayaudit audit --cases`), and the
+// export of generated cases with their exact verdicts as portable test vectors.
+//
+// Format: a header line naming the columns; required ox,oy,oz,dx,dy,dz,
+// ax,ay,az,bx,by,bz,cx,cy,cz (decimal or C99 hex floats, whole field
+// consumed by std::strtod); optional id; every other column ignored. Fields
+// are separated by commas, without quoting; blank lines are skipped. The ray
+// is {o + t d : t >= 0}. The export writes id,family,sweep, the 15 inputs as
+// %a, then verdict and t (%a, empty when there is no crossing).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "families.h"
+#include "oracle.h"
+
+namespace ra::audit {
+
+struct UserCase {
+  std::string id;  // the id column, or the 1-based data row number
+  bool id_is_row = false;
+  Rayd ray;
+  Tri tri;
+};
+
+// Throws ra::InputError "FILE:LINE: what is wrong" on a missing file, a
+// missing column, a wrong field count or a bad number.
+std::vector<UserCase> read_cases_csv(const std::string& path);
+
+struct ExportRow {
+  std::string id, family, sweep;
+  Rayd ray;
+  Tri tri;
+  oracle::Answer answer;
+};
+std::string cases_csv(const std::vector<ExportRow>& rows);
+
+// The generated cases of the given triangle families (the secondary family,
+// whose rays depend on each method, and sphere families are skipped).
+std::vector<ExportRow> export_rows(const std::vector<std::string>& families, Precision p,
+                                   std::uint64_t seed, long long rays);
+
+}  // namespace ra::audit

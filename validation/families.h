@@ -1,0 +1,78 @@
+// Case families for the audit: seeded, reproducible generators of rays and
+// triangles (or spheres), each with a sweep parameter (issue 6; REFERENCES.md).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ray.h"
+#include "registry.h"
+
+namespace ra::audit {
+
+enum class Precision { f32, f64 };
+const char* precision_name(Precision p);  // "float" / "double"
+
+struct Tri {
+  Vec3d a, b, c;
+};
+
+// One ray tested against triangles [first, first + count) of its batch. A
+// probe with count > 1 is a group (edge pair, vertex fan, closed mesh):
+// leaks and double hits are judged over the group.
+struct Probe {
+  Rayd ray;
+  int first = 0;
+  int count = 1;
+  // A closed mesh around the origin: every ray must leave through it, so it
+  // is judged for leaks without the group_is_proper test.
+  bool closed = false;
+};
+
+struct TriangleBatch {
+  std::vector<Tri> tris;
+  std::vector<Probe> probes;
+};
+
+struct SphereCase {
+  Rayd ray;
+  Vec3d center;
+  double radius = 1;
+};
+
+struct Family {
+  std::string name;
+  Kind kind;                        // triangle or sphere
+  std::string param;                // what the sweep varies, e.g. "offset"
+  std::vector<std::string> sweep;   // one label per sweep value
+  bool grouped = false;             // probes hold several triangles
+  bool secondary = false;           // spawned rays (handled by the audit engine)
+  // Triangles each probe tests, for turning a case budget into probes.
+  int tris_per_probe(int sweep_index) const;
+};
+
+// All families, triangles first, in a fixed order.
+const std::vector<Family>& families();
+const Family* find_family(const std::string& name);
+std::string family_names();
+
+// A deterministic stream per (seed, family, sweep value, chunk): the same
+// cases whatever the thread count or which other families run.
+std::uint64_t stream_seed(std::uint64_t seed, const std::string& family, int sweep, int chunk);
+
+// `count` probes of a triangle family. Cases are made in double; for f32 every
+// coordinate is then rounded to float, so the oracle judges what the float
+// method gets. near-miss steps in ulps of the requested precision.
+void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,
+              TriangleBatch& out);
+void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,
+              std::vector<SphereCase>& out);
+
+// A group judged for leaks: every triangle clearly faces the ray's direction
+// the same way (no fold seen along d, none edge-on or degenerate).
+bool group_is_proper(const Tri* tris, int count, const Vec3d& d);
+
+// The secondary family's sweep index = strategy * scales + scale index.
+int secondary_strategy(int sweep);
+
+}  // namespace ra::audit
