@@ -44,6 +44,7 @@ Vec3d normalized_or(const Vec3d& v, const Vec3d& fallback) {
 Vec3d bump_height(const Vec3d& n, const Texture& deriv, TextureFilter filter, double strength, double u, double v,
                   const UvBasis& basis) {
   const Vec3d s = deriv.sample(u, v, filter);
+  if (s.x == 0 && s.y == 0) return n;  // n += 0: no renormalisation either
   // Image +y runs towards -v.
   return normalized_or(n + (basis.tu * s.x - basis.tv * s.y) * strength, n);
 }
@@ -52,6 +53,7 @@ Vec3d bump_normal_map(const Vec3d& n, const Texture& map, TextureFilter filter, 
                       double v, const UvBasis& basis) {
   const Vec3d c = map.sample(u, v, filter);
   const Vec3d d = c * 2.0 - Vec3d{1, 1, 1};
+  if (d.x == 0 && d.y == 0 && d.z > 0) return n;  // no deflection
   return normalized_or((basis.tu * d.x + basis.tv * d.y) * strength + n * d.z, n);
 }
 

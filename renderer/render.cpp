@@ -493,6 +493,13 @@ Tracer::~Tracer() = default;
 Color Tracer::trace(const Ray<double>& ray) const { return impl_->trace(ray, 1, 1.0); }
 std::optional<SceneHit> Tracer::intersect(const Ray<double>& ray) const { return impl_->intersect(ray); }
 Color Tracer::pixel(int i, int j) const { return impl_->pixel(i, j); }
+std::optional<Tracer::ShadingPoint> Tracer::shading_point(const Ray<double>& ray) const {
+  const auto hit = impl_->intersect(ray);
+  if (!hit) return std::nullopt;
+  Impl::Surface s = impl_->surface(ray, *hit);
+  impl_->bump_document(s);
+  return ShadingPoint{s.p, s.ng, s.n, s.has_uv, s.u, s.v};
+}
 
 Image Tracer::render() const {
   const Scene& s = impl_->scene;
