@@ -20,7 +20,7 @@ struct RenderOptions {
   std::string sphere_method = "stable";
   bool use_double = true;  // intersection precision; shading is always double
   bool cull = false;       // backface culling for triangles (document 002)
-  Accel accel = Accel::none;
+  Accel accel = Accel::bvh;  // none and sphere are document 002's; bvh the modern reference
   SelfIntersection self_intersection = SelfIntersection::pov;
   int threads = 0;          // 0: all cores
   int samples_per_axis = 1; // n x n samples per pixel, averaged
@@ -49,6 +49,16 @@ class Tracer {
   Color trace(const Ray<double>& ray) const;
   // The closest hit of a ray, if any (the ray's own window applies).
   std::optional<SceneHit> intersect(const Ray<double>& ray) const;
+  // The surface where a ray first hits: point, geometric normal and the
+  // shading normal as lighting sees it before the face-forward flip
+  // (interpolated for smooth meshes, with document 002's bumps applied), and
+  // the UVs. nullopt on a miss. For tests and tools.
+  struct ShadingPoint {
+    Vec3d p, ng, n;
+    bool has_uv = false;
+    double u = 0, v = 0;
+  };
+  std::optional<ShadingPoint> shading_point(const Ray<double>& ray) const;
   // The colour of pixel (i, j), averaging the n x n samples.
   Color pixel(int i, int j) const;
   // Renders the whole image in 32 x 32 tiles on `threads` threads; the

@@ -1,0 +1,502 @@
+// Meshes in the tracer without golden images: smooth normals against the
+// analytic sphere, texture lookups at known UVs, bump variants that must not
+// change a flat surface, culling and the three accelerations changing
+// nothing, the MTL -> finish mapping, and mesh placement.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+
+#include "bump.h"
+#include "bvh.h"
+#include "camera.h"
+#include "image.h"
+#include "registry.h"
+#include "render.h"
+#include "scene_mesh.h"
+#include "texture.h"
+
+namespace ra {
+namespace {
+
+std::filesystem::path temp_dir() {
+  auto d = std::filesystem::temp_directory_path() / ("rayaudit_mesh_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+void write_text(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+
+// A UV sphere of radius 1 at the origin: `rings` x `segments`, triangles
+// wound outward, optionally with exact vn (= the vertex position).
+std::string uv_sphere_obj(int rings, int segments, bool with_vn) {
+  std::string s;
+  char buf[160];
+  std::vector<int> index((rings + 1) * segments);
+  int n = 0;
+  for (int r = 0; r <= rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      if ((r == 0 || r == rings) && k > 0) {
+        index[r * segments + k] = index[r * segments];
+        continue;
+      }
+      const double th = M_PI * r / rings, ph = 2 * M_PI * k / segments;
+      const double x = std::sin(th) * std::cos(ph), y = std::cos(th), z = -std::sin(th) * std::sin(ph);
+      std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g\n", x, y, z);
+      s += buf;
+      if (with_vn) {
+        std::snprintf(buf, sizeof buf, "vn %.17g %.17g %.17g\n", x, y, z);
+        s += buf;
+      }
+      index[r * segments + k] = ++n;
+    }
+  auto face = [&](int a, int b, int c) {
+    if (with_vn) std::snprintf(buf, sizeof buf, "f %d//%d %d//%d %d//%d\n", a, a, b, b, c, c);
+    else std::snprintf(buf, sizeof buf, "f %d %d %d\n", a, b, c);
+    s += buf;
+  };
+  for (int r = 0; r < rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      const int a = index[r * segments + k], b = index[r * segments + (k + 1) % segments];
+      const int c = index[(r + 1) * segments + k], d = index[(r + 1) * segments + (k + 1) % segments];
+      if (r > 0) face(a, c, b);
+      if (r < rings - 1) face(b, c, d);
+    }
+  return s;
+}
+
+RenderOptions opts() {
+  RenderOptions o;
+  o.progress = false;
+  o.threads = 2;
+  return o;
+}
+
+Vec3d random_unit(std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  return normalize(Vec3d{g(rng), g(rng), g(rng)});
+}
+
+double angle(const Vec3d& a, const Vec3d& b) {
+  return std::atan2(length(cross(a, b)), dot(a, b));
+}
+
+// ---------------------------------------------------------------- smooth
+
+// With exact vertex normals on a unit sphere, document 002's interpolation
+// n = normalize(nA + l2 (nB - nA) + l3 (nC - nA)) = normalize(p) for the hit
+// point p = A + l2 (B - A) + l3 (C - A): the analytic sphere's normal in the
+// direction of p. Only rounding separates them: a few ulps, bound 1e-12 rad.
+TEST(SmoothNormals, ExactVertexNormalsGiveTheRadialDirection) {
+  const auto dir = temp_dir();
+  write_text(dir / "sphere_vn.obj", uv_sphere_obj(12, 24, true));
+  MeshPlacement place;
+  place.file = dir / "sphere_vn.obj";
+  place.shading = Shading::smooth;
+  Scene scene;
+  Object o;
+  o.kind = Object::Kind::mesh;
+  o.mesh = load_placed_mesh(place);
+  scene.objects.push_back(o);
+  Tracer tr(scene, opts());
+  const unsigned seed = 20240501;
+  std::mt19937_64 rng(seed);
+  int hits = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3d from = random_unit(rng) * 4.0, target = random_unit(rng) * 0.5;
+    auto sp = tr.shading_point({from, target - from});
+    if (!sp) continue;
+    ++hits;
+    ASSERT_LT(angle(sp->n, normalize(sp->p)), 1e-12) << "seed " << seed << " ray " << i;
+  }
+  EXPECT_GT(hits, 1500);
+}
+
+// Area-weighted vertex normals (no vn). Bound, for a triangle inscribed in
+// the unit sphere with angular circumradius rho (the angle between its face
+// normal and each of its vertices):
+//  - each vertex normal is a weighted mean of face normals that are all
+//    within rho_max of the vertex's radial direction, so it is within rho_max
+//    of it (a cone of half-angle < 90 degrees is convex);
+//  - the interpolated N' = sum b_i m_i differs from N = sum b_i v_i = p by at
+//    most 2 sin(rho_max / 2), and |N| >= cos(rho) (each v_i makes the angle
+//    rho with the face normal);
+//  - so angle(normalize(N'), p) <= asin(2 sin(rho_max / 2) / cos(rho_max)).
+TEST(SmoothNormals, AreaWeightedNormalsStayWithinTheDerivedBound) {
+  const auto dir = temp_dir();
+  write_text(dir / "sphere.obj", uv_sphere_obj(12, 24, false));
+  MeshPlacement place;
+  place.file = dir / "sphere.obj";
+  place.shading = Shading::smooth;
+  Scene scene;
+  Object o;
+  o.kind = Object::Kind::mesh;
+  o.mesh = load_placed_mesh(place);
+  scene.objects.push_back(o);
+  double rho = 0;
+  for (const auto& t : o.mesh->triangles) {
+    const Vec3d a = o.mesh->positions[t.v[0]], b = o.mesh->positions[t.v[1]], c = o.mesh->positions[t.v[2]];
+    const Vec3d nf = normalize(cross(b - a, c - a));
+    for (const Vec3d& v : {a, b, c}) rho = std::max(rho, angle(nf, v));
+  }
+  const double bound = std::asin(2 * std::sin(rho / 2) / std::cos(rho));
+  ASSERT_LT(bound, 0.5);  // 12 x 24: rho ~ 0.19 rad, bound ~ 0.19 rad
+  Tracer tr(scene, opts());
+  const unsigned seed = 77;
+  std::mt19937_64 rng(seed);
+  double worst = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3d from = random_unit(rng) * 4.0, target = random_unit(rng) * 0.5;
+    auto sp = tr.shading_point({from, target - from});
+    if (!sp) continue;
+    worst = std::max(worst, angle(sp->n, normalize(sp->p)));
+  }
+  EXPECT_LE(worst, bound) << "seed " << seed << " rho " << rho;
+  // And smooth shading is far closer than flat shading's rho.
+  EXPECT_LT(worst, rho);
+}
+
+// -------------------------------------------------------------- textures
+
+Texture numbered(int w, int h) {
+  Texture t(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) t.set(x, y, {double(x), double(y), 0});
+  return t;
+}
+
+TEST(Texture, NearestSamplesTheTexelUnderTheUv) {
+  const Texture t = numbered(4, 2);
+  // Texel (x, y) covers u in [x/W, (x+1)/W), v in [1 - (y+1)/H, 1 - y/H).
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const Vec3d c = t.nearest((x + 0.5) / 4, 1 - (y + 0.5) / 2);
+      EXPECT_EQ(c, (Vec3d{double(x), double(y), 0}));
+    }
+}
+
+TEST(Texture, VZeroIsTheBottomRow) {
+  const Texture t = numbered(4, 2);
+  EXPECT_EQ(t.nearest(0.1, 0.0).y, 1);   // bottom row is image row H-1
+  EXPECT_EQ(t.nearest(0.1, 0.99).y, 0);  // top
+}
+
+TEST(Texture, NearestRepeatsInBothDirections) {
+  const Texture t = numbered(4, 2);
+  EXPECT_EQ(t.nearest(1.3, 0.25), t.nearest(0.3, 0.25));
+  EXPECT_EQ(t.nearest(-0.1, 0.25).x, 3);
+  EXPECT_EQ(t.nearest(0.3, -0.25).y, t.nearest(0.3, 0.75).y);
+  EXPECT_EQ(t.nearest(0.3, 2.75), t.nearest(0.3, 0.75));
+}
+
+TEST(Texture, BilinearIsExactAtTexelCentresAndAveragesBetween) {
+  const Texture t = numbered(4, 2);
+  // Centre of texel (1, 0): u = 1.5/4, v = 1 - 0.5/2 (up to POV's EPSILON).
+  const Vec3d c = t.bilinear(1.5 / 4, 0.75);
+  EXPECT_NEAR(c.x, 1, 1e-8);
+  EXPECT_NEAR(c.y, 0, 1e-8);
+  // Halfway between the centres of texels 1 and 2 in x.
+  EXPECT_NEAR(t.bilinear(2.0 / 4, 0.75).x, 1.5, 1e-8);
+}
+
+TEST(Texture, BilinearWrapsAtTheBorders) {
+  const Texture t = numbered(4, 2);
+  // At u = 0 the lookup sits halfway between texel 0 and the LAST column.
+  EXPECT_NEAR(t.bilinear(0.0, 0.75).x, (0 + 3) / 2.0, 1e-8);
+  // At v = 0 (the bottom edge) halfway between the bottom row and the top.
+  EXPECT_NEAR(t.bilinear(1.5 / 4, 0.0).y, (1 + 0) / 2.0, 1e-8);
+}
+
+TEST(Texture, PigmentOfATexturedMeshIsTheTexelAtItsUv) {
+  const auto dir = temp_dir();
+  // 2 x 2: top-left red, top-right green, bottom-left blue, bottom-right white.
+  Image img(2, 2);
+  auto put = [&](int x, int y, float r, float g, float b) {
+    float* p = img.at(x, y);
+    p[0] = r, p[1] = g, p[2] = b;
+  };
+  put(0, 0, 1, 0, 0);
+  put(1, 0, 0, 1, 0);
+  put(0, 1, 0, 0, 1);
+  put(1, 1, 1, 1, 1);
+  write_image(dir / "quad.png", img);
+  write_text(dir / "quad.obj",
+             "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+             "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+  write_text(dir / "quad.json", R"({"lights": [], "ambient_light": 1, "objects": [{"mesh": "quad.obj",
+      "material": {"ambient": 1, "diffuse": 0, "texture": {"file": "quad.png", "filter": "nearest"}}}]})");
+  Scene scene = load_scene(dir / "quad.json");
+  Tracer tr(scene, opts());
+  auto at = [&](double x, double y) { return tr.trace({{x, y, 5}, {0, 0, -1}}); };
+  EXPECT_EQ(at(-0.5, 0.5), (Color{1, 0, 0}));   // top-left of the quad = top-left texel
+  EXPECT_EQ(at(0.5, 0.5), (Color{0, 1, 0}));
+  EXPECT_EQ(at(-0.5, -0.5), (Color{0, 0, 1}));  // v = 0 at the bottom
+  EXPECT_EQ(at(0.5, -0.5), (Color{1, 1, 1}));
+}
+
+// ------------------------------------------------------------------ bump
+
+TEST(Bump, UvBasisFollowsTheUvLayout) {
+  auto b = uv_basis({0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {0, 0}, {1, 0}, {0, 1});
+  ASSERT_TRUE(b);
+  EXPECT_NEAR(length(b->tu - Vec3d{1, 0, 0}), 0, 1e-15);
+  EXPECT_NEAR(length(b->tv - Vec3d{0, 1, 0}), 0, 1e-15);
+  // UVs turned: AB carries +v and AC carries -u, so +u runs along -y.
+  b = uv_basis({0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {0, 0}, {0, 1}, {-1, 0});
+  ASSERT_TRUE(b);
+  EXPECT_NEAR(length(b->tu - Vec3d{0, -1, 0}), 0, 1e-15);
+  EXPECT_NEAR(length(b->tv - Vec3d{1, 0, 0}), 0, 1e-15);
+  EXPECT_FALSE(uv_basis({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0}, {1, 1}, {2, 2}));
+}
+
+TEST(Bump, HeightVariantOnAFlatMapChangesNothing) {
+  Texture flat(8, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) flat.set(x, y, {0.4, 0.5, 0.6});
+  const Texture d = height_derivatives(flat);
+  const UvBasis basis{{1, 0, 0}, {0, 1, 0}};
+  const Vec3d n = normalize(Vec3d{0.1, -0.2, 1});
+  for (double u : {0.0, 0.3, 0.999})
+    for (auto f : {TextureFilter::nearest, TextureFilter::bilinear})
+      EXPECT_EQ(bump_height(n, d, f, 10.0, u, 0.7, basis), n);
+}
+
+TEST(Bump, HeightVariantTiltsAwayFromTheHighSide) {
+  // Brighter (higher) to the right: the surface rises along +u, so the normal
+  // tilts towards -u.
+  Texture ramp(8, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) ramp.set(x, y, Vec3d{1, 1, 1} * (x / 8.0));
+  const Texture d = height_derivatives(ramp);
+  const UvBasis basis{{1, 0, 0}, {0, 1, 0}};
+  const Vec3d n = bump_height({0, 0, 1}, d, TextureFilter::nearest, 1.0, 0.4, 0.5, basis);
+  EXPECT_LT(n.x, 0);
+  EXPECT_NEAR(n.y, 0, 1e-15);
+}
+
+TEST(Bump, NormalMapAndPovOnFlatMapsChangeNothing) {
+  Texture up(4, 4), grey(4, 4);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      up.set(x, y, {0.5, 0.5, 1});
+      grey.set(x, y, {0.3, 0.3, 0.3});
+    }
+  const UvBasis basis{{1, 0, 0}, {0, 0, -1}};
+  const Vec3d n{0, 1, 0};
+  EXPECT_EQ(bump_normal_map(n, up, TextureFilter::bilinear, 1.0, 0.3, 0.3, basis), n);
+  const Vec3d m = normalize(Vec3d{0.3, 0.8, 0.2});
+  const Vec3d p = bump_pov(m, grey, TextureFilter::bilinear, 0.5, 0.3, 0.6);
+  EXPECT_NEAR(length(p - m), 0, 1e-15);
+}
+
+// Whole renders: a flat height map on a mesh gives the same image as no bump.
+TEST(Bump, FlatHeightMapRendersTheSameImage) {
+  const auto dir = temp_dir();
+  Image img(4, 4);
+  for (float& v : img.rgb) v = 0.5f;
+  write_image(dir / "flat.png", img);
+  write_text(dir / "q.obj",
+             "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+             "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+  const std::string head = R"({"width": 32, "height": 24, "lights": [{"position": [-2, 1, 3]}],
+      "objects": [{"mesh": "q.obj", "rotate": [["x", -0.8]], "material": {"phong": 0.5)";
+  write_text(dir / "plain.json", head + "}}]}");
+  write_text(dir / "bumped.json", head + R"(, "bump": {"file": "flat.png", "strength": 50}}}]})");
+  const Image a = render(load_scene(dir / "plain.json"), opts());
+  const Image b = render(load_scene(dir / "bumped.json"), opts());
+  EXPECT_EQ(a.rgb, b.rgb);
+}
+
+// ------------------------------------------------- culling, accelerations
+
+Scene accel_scene(const std::filesystem::path& dir) {
+  write_text(dir / "ball.obj", uv_sphere_obj(16, 32, false));
+  write_text(dir / "accel.json", R"({"width": 48, "height": 36,
+      "camera": {"position": [0.3, 1.5, 5], "look_at": [0, 0.2, 0], "vfov": 50},
+      "lights": [{"position": [3, 5, 4]}],
+      "objects": [
+        {"plane": {"normal": [0, 1, 0], "offset": -1}, "material": {"reflection": 0.3}},
+        {"mesh": "ball.obj", "shading": "smooth", "translate": [-0.6, 0, 0], "material": {"phong": 0.5, "reflection": 0.2}},
+        {"mesh": "ball.obj", "translate": [1.2, 0, -0.5], "scale": 0.7, "rotate": [["y", 0.3]]},
+        {"sphere": {"center": [0.3, -0.6, 1.2], "radius": 0.4}}
+      ]})");
+  return load_scene(dir / "accel.json");
+}
+
+// Methods whose hits lie inside the triangle up to rounding; the document
+// variants that widen triangles by an absolute tolerance (angles, areas)
+// find hits outside any bounding volume, which the accelerations rightly
+// drop (see scenes/README.md).
+bool exact_inside(const std::string& name) { return name != "angles" && name != "areas"; }
+
+TEST(Accel, NoneSphereAndBvhGiveBitIdenticalImages) {
+  const Scene scene = accel_scene(temp_dir());
+  for (const Method& m : methods()) {
+    if (m.kind != Kind::triangle || !exact_inside(m.name)) continue;
+    for (bool dbl : {true, false}) {
+      RenderOptions o = opts();
+      o.triangle_method = m.name;
+      o.use_double = dbl;
+      o.accel = Accel::none;
+      const Image none = render(scene, o);
+      o.accel = Accel::sphere;
+      const Image sphere = render(scene, o);
+      o.accel = Accel::bvh;
+      const Image bvh = render(scene, o);
+      EXPECT_EQ(none.rgb, sphere.rgb) << m.name << (dbl ? " double" : " float");
+      EXPECT_EQ(none.rgb, bvh.rgb) << m.name << (dbl ? " double" : " float");
+    }
+  }
+}
+
+// Document 002: on a closed mesh a ray from outside meets a front face
+// first, so skipping back faces changes no camera hit. (Secondary rays that
+// start ON a smooth mesh can legitimately differ: near the shading
+// terminator a shadow ray may leave through the back of a neighbouring
+// triangle, which culling skips. The whole-image check therefore uses flat
+// shading, where a lit point's shadow ray always leaves through the front.)
+TEST(Accel, CullingChangesNothingOnClosedMeshesSeenFromOutside) {
+  const auto dir = temp_dir();
+  write_text(dir / "ball.obj", uv_sphere_obj(16, 32, false));
+  for (const char* shading : {"flat", "smooth"}) {
+    write_text(dir / "closed.json", std::string(R"({"width": 48, "height": 36, "lights": [{"position": [3, 5, 4]}],
+        "objects": [{"mesh": "ball.obj", "shading": ")") + shading + R"("},
+                    {"mesh": "ball.obj", "translate": [1.8, 0.5, -1], "shading": ")" + shading + R"("}]})");
+    const Scene scene = load_scene(dir / "closed.json");
+    for (Accel a : {Accel::none, Accel::sphere, Accel::bvh}) {
+      RenderOptions o = opts();
+      o.accel = a;
+      o.cull = false;
+      const Tracer plain(scene, o);
+      o.cull = true;
+      const Tracer culled(scene, o);
+      const Camera cam(scene.camera, scene.width, scene.height);
+      for (int j = 0; j < scene.height; ++j)
+        for (int i = 0; i < scene.width; ++i) {
+          const auto r = cam.ray(i + 0.5, j + 0.5);
+          const auto h1 = plain.intersect(r), h2 = culled.intersect(r);
+          ASSERT_EQ(h1.has_value(), h2.has_value()) << i << "," << j;
+          if (h1) EXPECT_TRUE(h1->t == h2->t && h1->object == h2->object && h1->prim == h2->prim);
+        }
+      if (std::string(shading) == "flat") EXPECT_EQ(plain.render().rgb, culled.render().rgb) << accel_name(a);
+    }
+  }
+}
+
+TEST(Accel, BvhLeavesHoldAtMostFourTrianglesAndEveryTriangleOnce) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-10, 10);
+  std::vector<Vec3d> lo, hi;
+  for (int i = 0; i < 5000; ++i) {
+    const Vec3d c{u(rng), u(rng), u(rng)};
+    lo.push_back(c - Vec3d{0.1, 0.1, 0.1});
+    hi.push_back(c + Vec3d{0.1, 0.2, 0.05});
+  }
+  const Bvh b = Bvh::build(lo, hi, 0);
+  std::vector<int> seen(lo.size(), 0);
+  for (const auto& n : b.nodes)
+    if (n.count > 0) {
+      EXPECT_LE(n.count, Bvh::kMaxLeaf);
+      for (unsigned s = n.index; s < n.index + n.count; ++s) {
+        ++seen[b.order[s]];
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_LE(n.lo[a], lo[b.order[s]][a]);
+          EXPECT_GE(n.hi[a], hi[b.order[s]][a]);
+        }
+      }
+    }
+  for (int c : seen) EXPECT_EQ(c, 1);
+}
+
+// ------------------------------------------------------ MTL and placement
+
+TEST(MtlMapping, PhongTermsMapOntoPovFinish) {
+  MtlMaterial m;
+  m.name = "doc004";
+  m.Ka = {0.3, 0.4, 0.5};
+  m.Kd = {0.3775, 0.3775, 0.5775};
+  m.Ks = {0.9, 0.6, 0.3};
+  m.Ns = 10.6;
+  const Material out = material_from_mtl(m);
+  EXPECT_EQ(out.color, m.Kd);
+  EXPECT_EQ(out.diffuse, 1.0);
+  // C * ambient = Kd * Ka / Kd = Ka.
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(out.color[c] * out.ambient[c], m.Ka[c], 1e-15);
+  EXPECT_NEAR(out.phong, 0.6, 1e-15);
+  EXPECT_EQ(out.phong_size, 10.6);
+  EXPECT_FALSE(out.texture);
+  EXPECT_FALSE(out.bump);
+}
+
+TEST(MtlMapping, AmbientWithoutDiffuseIsDroppedWithAWarning) {
+  MtlMaterial m;
+  m.name = "light";
+  m.Ka = {20, 20, 20};
+  m.Kd = {0, 0, 0};
+  std::vector<std::string> warnings;
+  const Material out = material_from_mtl(m, &warnings);
+  EXPECT_EQ(out.ambient, (Vec3d{0, 0, 0}));
+  EXPECT_FALSE(warnings.empty());
+}
+
+TEST(MtlMapping, MapsBecomeTextureAndHeightBump) {
+  const auto dir = temp_dir();
+  Image img(2, 2);
+  write_image(dir / "t.png", img);
+  write_text(dir / "m.obj", "mtllib m.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write_text(dir / "m.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd t.png\nmap_bump -bm 3 t.png\n");
+  MeshPlacement place;
+  place.file = dir / "m.obj";
+  auto set = load_placed_mesh(place);
+  ASSERT_GE(set->materials.size(), 1u);
+  const Material& m = set->materials[set->triangles[0].material];
+  ASSERT_TRUE(m.texture);
+  EXPECT_EQ(m.texture->file.filename(), "t.png");
+  ASSERT_TRUE(m.bump);
+  EXPECT_EQ(m.bump->variant, BumpVariant::height);
+  EXPECT_EQ(m.bump->strength, 3.0);
+}
+
+TEST(Placement, RotationsInOrderThenScaleThenTranslateAndNormalsRotated) {
+  const auto dir = temp_dir();
+  write_text(dir / "p.obj", "v 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 5\nf 1//1 2//1 3//1\n");
+  MeshPlacement place;
+  place.file = dir / "p.obj";
+  place.rotations = {{'x', M_PI / 2}, {'y', M_PI / 2}};
+  place.scale = 2;
+  place.translate = {10, 0, 0};
+  auto set = load_placed_mesh(place);
+  // (0,1,0): about x by 90 -> (0,0,1); about y by 90 -> (1,0,0); x2, +10.
+  EXPECT_NEAR(length(set->positions[1] - Vec3d{12, 0, 0}), 0, 1e-12);
+  // vn (0,0,5): about x -> (0,-1,0) normalised; about y -> unchanged.
+  EXPECT_NEAR(length(set->normals[0] - Vec3d{0, -1, 0}), 0, 1e-12);
+}
+
+TEST(Placement, CachePrefixExpandsToTheCacheDirectory) {
+  ::setenv("RAYAUDIT_CACHE", "/some/cache", 1);
+  auto p = expand_cache_prefix("${cache}/corpus/ladder/dragon.obj");
+  ::unsetenv("RAYAUDIT_CACHE");
+  ASSERT_TRUE(p);
+  EXPECT_EQ(*p, std::filesystem::path("/some/cache/corpus/ladder/dragon.obj"));
+  EXPECT_FALSE(expand_cache_prefix("meshes/cube.obj"));
+}
+
+TEST(Placement, BareObjIsAWholeSceneWithCameraAndLight) {
+  const auto dir = temp_dir();
+  write_text(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  Scene s = load_scene(dir / "tri.obj");
+  ASSERT_EQ(s.objects.size(), 1u);
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_EQ(s.lights[0].position, s.camera.position);
+  Tracer tr(s, opts());
+  // The camera looks at the bounding sphere's centre, on the triangle.
+  EXPECT_TRUE(tr.intersect({s.camera.position, s.camera.look_at - s.camera.position}));
+}
+
+}  // namespace
+}  // namespace ra
