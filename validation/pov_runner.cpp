@@ -89,9 +89,13 @@ std::string pov_ini(int bits) {
 }
 
 PovRun render_with_povray(const Scene& scene, const PovRunOptions& options) {
+  find_povray();  // say that POV-Ray is missing before anything else
+  return run_povray(export_pov(scene), scene.width, scene.height, options);
+}
+
+PovRun run_povray(const PovExport& ex, int width, int height, const PovRunOptions& options) {
   if (options.bits != 8 && options.bits != 16) throw InputError("POV-Ray bits per colour must be 8 or 16");
   const fs::path povray = find_povray();
-  const PovExport ex = export_pov(scene);
 
   // A private directory: mkdtemp creates it mode 0700 under a fresh name.
   std::string tmpl = "/tmp/rayaudit-pov-XXXXXX";
@@ -105,16 +109,17 @@ PovRun render_with_povray(const Scene& scene, const PovRunOptions& options) {
                                          "rayaudit.ini",
                                          "+Iscene.pov",
                                          "+Oout.png",
-                                         "+W" + std::to_string(scene.width),
-                                         "+H" + std::to_string(scene.height),
+                                         "+W" + std::to_string(width),
+                                         "+H" + std::to_string(height),
                                          "+WT1"};
   const int code = run_in(work.path, argv, work.path / "povray.out", work.path / "povray.err");
   PovRun run;
   run.log = read_text(work.path / "povray.err");
   if (code != 0 || !fs::exists(work.path / "out.png")) {
-    work.keep = true;
+    work.keep = options.keep_on_failure;
     throw CheckFailed("POV-Ray failed (" + (code < 0 ? std::string("killed") : "exit " + std::to_string(code)) +
-                      ") on the exported scene; its files are kept in " + work.path.string() +
+                      ") on the exported scene" +
+                      (work.keep ? "; its files are kept in " + work.path.string() : std::string()) +
                       "\n--- POV-Ray's stderr ---\n" + run.log);
   }
   run.image = read_image(work.path / "out.png");

@@ -16,6 +16,7 @@ namespace ra {
 struct PovRunOptions {
   int bits = 8;           // Bits_Per_Color: 8 or 16
   bool keep_dir = false;  // keep the working directory (its path is in PovRun::dir)
+  bool keep_on_failure = true;  // keep it when POV-Ray fails, to look at
 };
 
 struct PovRun {
@@ -35,5 +36,10 @@ std::string pov_ini(int bits);
 // when POV-Ray is missing or the scene is not expressible, CheckFailed (with
 // POV's stderr, and the working directory kept for a look) when POV fails.
 PovRun render_with_povray(const Scene& scene, const PovRunOptions& options = {});
+
+// The same for SDL already written (render_with_povray exports, then calls
+// this): the images are copied in under their generated names.
+struct PovExport;
+PovRun run_povray(const PovExport& sdl, int width, int height, const PovRunOptions& options = {});
 
 }  // namespace ra
