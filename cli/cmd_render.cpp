@@ -13,7 +13,7 @@ struct Args {
   std::string scene, out;
   int width = 0, height = 0, threads = 0, spp = 1, bits = 8;
   std::vector<std::string> methods;
-  std::string precision = "double", accel = "none", self_intersection = "pov";
+  std::string precision = "double", accel = "bvh", self_intersection = "pov";
   bool cull = false, srgb = false;
 };
 
@@ -81,7 +81,7 @@ void setup(CLI::App& app) {
       ->take_all();
   cmd->add_option("--precision", args->precision, "Intersection precision: float or double (default double)");
   cmd->add_flag("--cull", args->cull, "Backface culling of triangles");
-  cmd->add_option("--accel", args->accel, "Acceleration: none, sphere (bounding spheres) or bvh");
+  cmd->add_option("--accel", args->accel, "Acceleration: bvh (default), sphere (document 002's bounding sphere) or none");
   cmd->add_option("--self-intersection", args->self_intersection,
                   "Secondary-ray strategy: eps, pov (default), normal-offset, ulp-offset");
   cmd->add_option("--bits", args->bits, "PNG bits per channel: 8 or 16 (default 8)");

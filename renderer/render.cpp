@@ -7,11 +7,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <map>
 #include <thread>
 
+#include "bump.h"
+#include "bvh.h"
 #include "camera.h"
 #include "errors.h"
 #include "registry.h"
+#include "texture.h"
 
 namespace ra {
 
@@ -37,12 +42,14 @@ constexpr double kMinCosIncidence = 1e-10;
 
 // A mesh ready for tracing at precision T: each triangle's prepared bytes
 // for the chosen method, its unit geometric normal, and the bounding sphere
-// of document 002's optimisation.
+// of document 002's optimisation. With --accel bvh the prepared bytes are
+// stored in the BVH's slot order (bvh.order maps a slot to its triangle).
 template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
   std::size_t stride = 0;
-  std::vector<unsigned char> pre;
+  std::vector<unsigned char> pre;  // per triangle, or per BVH slot
+  Bvh bvh;                         // --accel bvh only
   std::vector<Vec3d> gnormal;        // per triangle, (B-A)x(C-A) normalised
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
@@ -83,6 +90,8 @@ struct Tracer::Impl {
   std::vector<PreparedMesh<float>> meshes_f;
   std::vector<PreparedMesh<double>> meshes_d;
   std::vector<int> mesh_index;  // object -> index into meshes_*, or -1
+  TextureCache textures;        // every texture and bump image, loaded here
+  std::map<std::string, Texture> derivatives;  // height bumps: file -> (dx, dy)
 
   Impl(const Scene& s, const RenderOptions& o)
       : scene(s), opt(o), camera(s.camera, s.width, s.height) {
@@ -103,6 +112,24 @@ struct Tracer::Impl {
       mesh_index[i] = int(opt.use_double ? meshes_d.size() : meshes_f.size());
       if (opt.use_double) meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
       else meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
+    }
+    for (const Object& obj : s.objects) {
+      if (obj.kind == Object::Kind::mesh)
+        for (const Material& m : obj.mesh->materials) load_textures(m);
+      else
+        load_textures(obj.material);
+    }
+  }
+
+  // Loads a material's images once, before any thread renders.
+  void load_textures(const Material& m) {
+    if (m.texture) textures.load(m.texture->file);
+    if (m.bump) {
+      const Texture& img = textures.load(m.bump->file);
+      if (m.bump->variant == BumpVariant::height) {
+        const std::string key = m.bump->file.lexically_normal().string();
+        if (!derivatives.count(key)) derivatives.emplace(key, height_derivatives(img));
+      }
     }
   }
 
@@ -139,7 +166,57 @@ struct Tracer::Impl {
     }
     m.bs_center = (lo + hi) * 0.5;
     for (const auto& p : set.positions) m.bs_radius = std::max(m.bs_radius, length(p - m.bs_center));
+    if (opt.accel == Accel::bvh) build_bvh(m, k, lo, hi);
     return m;
+  }
+
+  // Builds the mesh's BVH and re-lays the prepared bytes in its slot order.
+  // Boxes are padded by a relative 1e-5 of the mesh's size and position, so
+  // that rounding in the kernels (float ones too) never puts a hit outside
+  // its box.
+  template <class T>
+  void build_bvh(PreparedMesh<T>& m, const TriangleKernels<T>& k, const Vec3d& mesh_lo, const Vec3d& mesh_hi) const {
+    const TriangleSet& set = *m.set;
+    const std::size_t n = set.triangles.size();
+    std::vector<Vec3d> lo(n), hi(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& t = set.triangles[i];
+      lo[i] = vmin(set.positions[t.v[0]], vmin(set.positions[t.v[1]], set.positions[t.v[2]]));
+      hi[i] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
+    }
+    const double size = std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
+    m.bvh = Bvh::build(lo, hi, 1e-5 * size);
+    std::vector<unsigned char> pre(m.pre.size());
+    for (std::size_t s = 0; s < n; ++s)
+      std::memcpy(pre.data() + s * m.stride, m.pre.data() + std::size_t(m.bvh.order[s]) * m.stride, m.stride);
+    m.pre = std::move(pre);
+  }
+
+  // Visits the BVH leaves the ray's window meets, near child first; `leaf`
+  // gets each slot and returns true to stop. `tmax` is re-read at every node
+  // (closest-hit shrinks it).
+  template <class T, class Leaf>
+  static void traverse(const Bvh& bvh, const Ray<T>& r, const T& tmax, Leaf&& leaf) {
+    if (bvh.nodes.empty()) return;
+    const Vec3d o(r.o), d(r.d);
+    const Vec3d inv{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
+    std::uint32_t stack[Bvh::kMaxDepth + 2];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const std::uint32_t ni = stack[--top];
+      const BvhNode& node = bvh.nodes[ni];
+      if (!ray_meets_box(node, o, inv, d, double(r.tmin), double(tmax))) continue;
+      if (node.count > 0) {
+        for (std::uint32_t s = node.index; s < node.index + node.count; ++s)
+          if (leaf(s)) return;
+        continue;
+      }
+      std::uint32_t near_child = ni + 1, far_child = node.index;
+      if (d[node.axis] < 0) std::swap(near_child, far_child);
+      stack[top++] = far_child;
+      stack[top++] = near_child;
+    }
   }
 
   template <class T>
@@ -176,11 +253,19 @@ struct Tracer::Impl {
         }
         case Object::Kind::mesh: {
           const auto& m = meshes<T>()[mesh_index[oi]];
+          const auto& k = tri_method->triangle<T>();
+          if (opt.accel == Accel::bvh) {
+            traverse(m.bvh, window, window.tmax, [&](std::uint32_t slot) {
+              if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, opt.cull))
+                consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
+              return false;
+            });
+            break;
+          }
           if (opt.accel == Accel::sphere &&
               !segment_meets_ball(Ray<double>{rd.o, rd.d, double(window.tmin), double(window.tmax)},
                                   m.bs_center, m.bs_radius))
             break;
-          const auto& k = tri_method->triangle<T>();
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
             if (auto h = k.hit_pre(window, m.pre.data() + i * m.stride, opt.cull))
@@ -207,10 +292,18 @@ struct Tracer::Impl {
           break;
         case Object::Kind::mesh: {
           const auto& m = meshes<T>()[mesh_index[oi]];
+          const auto& k = tri_method->triangle<T>();
+          if (opt.accel == Accel::bvh) {
+            bool hit = false;
+            traverse(m.bvh, r, r.tmax, [&](std::uint32_t slot) {
+              return hit = k.any_pre(r, m.pre.data() + slot * m.stride, opt.cull);
+            });
+            if (hit) return true;
+            break;
+          }
           if (opt.accel == Accel::sphere &&
               !segment_meets_ball(static_cast<Ray<double>>(r), m.bs_center, m.bs_radius))
             break;
-          const auto& k = tri_method->triangle<T>();
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
             if (k.any_pre(r, m.pre.data() + i * m.stride, opt.cull)) return true;
@@ -232,6 +325,7 @@ struct Tracer::Impl {
     const Material* material;
     bool has_uv = false;
     double u = 0, v = 0;
+    std::optional<UvBasis> basis;  // meshes with UVs and a bump map
   };
 
   Surface surface(const Ray<double>& ray, const SceneHit& h) const {
@@ -287,13 +381,43 @@ struct Tracer::Impl {
           s.v = ta[1] + (tb[1] - ta[1]) * h.b1 + (tc[1] - ta[1]) * h.b2;
         }
         s.material = &set.materials[std::clamp(tri.material, 0, int(set.materials.size()) - 1)];
+        if (s.has_uv && s.material->bump)
+          s.basis = uv_basis(a, b, c, set.uvs[tri.t[0]], set.uvs[tri.t[1]], set.uvs[tri.t[2]]);
         break;
       }
     }
     return s;
   }
 
-  Color pigment(const Surface& s) const { return s.material->color; }
+  // The pigment: the texture at (u, v) where the surface has UVs, else the
+  // material's colour.
+  Color pigment(const Surface& s) const {
+    const Material& m = *s.material;
+    if (m.texture && s.has_uv)
+      if (const Texture* t = textures.find(m.texture->file)) return t->sample(s.u, s.v, m.texture->filter);
+    return m.color;
+  }
+
+  // Document 002's bump variants act on the surface's own normal, before it
+  // is turned to face the ray.
+  void bump_document(Surface& s) const {
+    const Material& m = *s.material;
+    if (!m.bump || !s.has_uv || !s.basis || m.bump->variant == BumpVariant::pov) return;
+    const BumpMap& b = *m.bump;
+    if (b.variant == BumpVariant::height)
+      s.n = bump_height(s.n, derivatives.at(b.file.lexically_normal().string()), b.filter, b.strength, s.u, s.v,
+                        *s.basis);
+    else if (const Texture* t = textures.find(b.file))
+      s.n = bump_normal_map(s.n, *t, b.filter, b.strength, s.u, s.v, *s.basis);
+  }
+
+  // POV-Ray's bump_map perturbs the normal after the flip (trace.cpp).
+  void bump_pov_after_flip(Surface& s) const {
+    const Material& m = *s.material;
+    if (!m.bump || !s.has_uv || m.bump->variant != BumpVariant::pov) return;
+    if (const Texture* t = textures.find(m.bump->file))
+      s.n = ra::bump_pov(s.n, *t, m.bump->filter, m.bump->strength, s.u, s.v);
+  }
 
   bool shadowed(const Surface& s, const Vec3d& to_light, double dist) const {
     if (opt.use_double) {
@@ -320,7 +444,9 @@ struct Tracer::Impl {
     if (!hit) return scene.background;
     Surface s = surface(ray, *hit);
     const Vec3d d = normalize(ray.d);
+    bump_document(s);
     if (dot(s.n, d) > 0) s.n = -s.n;  // POV flips the normal to face the ray
+    bump_pov_after_flip(s);
     const Material& m = *s.material;
     const Color c = pigment(s);
     Color out = mul(mul(c, m.ambient), scene.ambient_light);

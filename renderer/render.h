@@ -20,7 +20,7 @@ struct RenderOptions {
   std::string sphere_method = "stable";
   bool use_double = true;  // intersection precision; shading is always double
   bool cull = false;       // backface culling for triangles (document 002)
-  Accel accel = Accel::none;
+  Accel accel = Accel::bvh;  // none and sphere are document 002's; bvh the modern reference
   SelfIntersection self_intersection = SelfIntersection::pov;
   int threads = 0;          // 0: all cores
   int samples_per_axis = 1; // n x n samples per pixel, averaged

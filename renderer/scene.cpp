@@ -119,6 +119,7 @@ TextureFilter parse_filter(ObjectReader& r, const std::string& key) {
 }
 
 std::filesystem::path resolve(const std::filesystem::path& scene_file, const std::string& p) {
+  if (auto cached = expand_cache_prefix(p)) return *cached;  // "${cache}/..."
   std::filesystem::path q(p);
   if (q.is_relative()) q = scene_file.parent_path() / q;
   return q;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh.h"  // BoundingSphere (one definition for the loader and the scene)
 #include "vec.h"
 
 namespace ra {
@@ -117,10 +118,6 @@ Scene load_scene(const std::filesystem::path& file);
 Scene parse_scene_json(const std::string& text, const std::filesystem::path& file);
 
 // Bounding sphere of everything bounded (planes excluded).
-struct BoundingSphere {
-  Vec3d center;
-  double radius = 0;
-};
 BoundingSphere scene_bounds(const Scene& scene);
 
 // Fills in the defaults that depend on the content: a camera framing the

@@ -1,6 +1,8 @@
 #include "scene_mesh.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "errors.h"
 
@@ -15,9 +17,98 @@ Vec3d rotate_about(char axis, double a, const Vec3d& p) {
   }
 }
 
+Material material_from_mtl(const MtlMaterial& m, std::vector<std::string>* warnings) {
+  Material out;
+  out.color = m.Kd;
+  out.diffuse = 1;
+  for (int c = 0; c < 3; ++c) {
+    if (m.Kd[c] > 0) {
+      out.ambient[c] = m.Ka[c] / m.Kd[c];
+    } else {
+      out.ambient[c] = 0;
+      if (m.Ka[c] > 0 && warnings)
+        warnings->push_back("material \"" + m.name +
+                            "\": Ka without Kd in a channel cannot be expressed as POV ambient; dropped");
+    }
+  }
+  out.phong = (m.Ks.x + m.Ks.y + m.Ks.z) / 3;
+  out.phong_size = m.Ns;
+  if (!m.map_Kd.empty() && std::filesystem::exists(m.map_Kd))
+    out.texture = ImageTexture{m.map_Kd, TextureFilter::bilinear};
+  if (!m.map_bump.empty() && std::filesystem::exists(m.map_bump))
+    out.bump = BumpMap{m.map_bump, BumpVariant::height, m.bump_multiplier, TextureFilter::bilinear};
+  return out;
+}
+
+namespace {
+
+Vec3d place_point(const MeshPlacement& pl, Vec3d p) {
+  for (const auto& [axis, a] : pl.rotations) p = rotate_about(axis, a, p);
+  return p * pl.scale + pl.translate;
+}
+
+// Normals under rotation + uniform scale: rotate, renormalise (the scale
+// does not change directions; a zero normal stays zero).
+Vec3d place_normal(const MeshPlacement& pl, Vec3d n) {
+  for (const auto& [axis, a] : pl.rotations) n = rotate_about(axis, a, n);
+  const double len = length(n);
+  return len > 0 ? n / len : n;
+}
+
+}  // namespace
+
 std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {
-  // The OBJ loader lands with its own issue; until then meshes are refused.
-  throw InputError(located(place.file.string(), 0, "OBJ meshes are not supported yet"));
+  ObjOptions opt;
+  opt.threads = 0;  // identical to serial (obj_loader.cpp); faster on the dragon
+  Mesh mesh = load_obj(place.file, opt);
+  std::vector<std::string> warnings = std::move(mesh.warnings);
+
+  auto set = std::make_shared<TriangleSet>();
+  set->name = place.file.string();
+  set->shading = place.shading;
+  set->positions.reserve(mesh.positions.size());
+  for (const auto& p : mesh.positions) set->positions.push_back(place_point(place, p));
+  set->normals.reserve(mesh.normals.size());
+  for (const auto& n : mesh.normals) set->normals.push_back(place_normal(place, n));
+  set->uvs = std::move(mesh.uvs);
+
+  // Materials: the MTL ones in order, then POV's default for triangles with
+  // none (material -1); an override replaces them all.
+  int fallback = 0;
+  if (place.material_override) {
+    set->materials = {*place.material_override};
+  } else {
+    for (const auto& m : mesh.materials) set->materials.push_back(material_from_mtl(m, &warnings));
+    fallback = int(set->materials.size());
+    set->materials.push_back(Material{});
+  }
+  set->triangles.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    MeshTriangle3 out;
+    for (int k = 0; k < 3; ++k) {
+      out.v[k] = t.v[k];
+      out.n[k] = t.n[k];
+      out.t[k] = t.t[k];
+    }
+    out.material = place.material_override ? 0 : (t.material >= 0 ? t.material : fallback);
+    set->triangles.push_back(out);
+  }
+  for (const auto& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  return set;
+}
+
+std::filesystem::path cache_dir() {
+  if (const char* c = std::getenv("RAYAUDIT_CACHE"); c && *c) return c;
+  const char* home = std::getenv("HOME");
+  return std::filesystem::path(home && *home ? home : "/tmp") / ".cache" / "rayaudit";
+}
+
+std::optional<std::filesystem::path> expand_cache_prefix(const std::string& path) {
+  static const std::string kPrefix = "${cache}";
+  if (path.compare(0, kPrefix.size(), kPrefix) != 0) return std::nullopt;
+  std::string rest = path.substr(kPrefix.size());
+  while (!rest.empty() && rest.front() == '/') rest.erase(rest.begin());
+  return cache_dir() / rest;
 }
 
 }  // namespace ra

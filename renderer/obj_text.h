@@ -1,0 +1,171 @@
+// Small scanning helpers shared by the OBJ and MTL parsers (fast_obj style:
+// each takes a pointer into one buffer and returns the pointer after what it
+// read; nothing allocates). A "statement" is one logical line: physical lines
+// joined by a `\` right before their end (LF or CRLF).
+#pragma once
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <string_view>
+
+#include "errors.h"
+#include "mesh.h"
+
+namespace ra::objtext {
+
+inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// True if the line break at `nl` (pointing at '\n') is escaped by `\`.
+inline bool escaped_newline(const char* begin, const char* nl) {
+  const char* q = nl;
+  if (q > begin && q[-1] == '\r') --q;
+  return q > begin && q[-1] == '\\';
+}
+
+// End of the statement starting at p: the '\n' ending it (or end). Adds to
+// `lines` the number of escaped line breaks inside it.
+inline const char* statement_end(const char* p, const char* end, long& lines) {
+  const char* begin = p;
+  for (;;) {
+    const char* nl = static_cast<const char*>(std::memchr(p, '\n', size_t(end - p)));
+    if (!nl) return end;
+    if (!escaped_newline(begin, nl)) return nl;
+    ++lines;
+    p = nl + 1;
+  }
+}
+
+// Skips whitespace and escaped line breaks, up to `end` (a statement end).
+inline const char* skip_ws(const char* p, const char* end) {
+  for (;;) {
+    while (p < end && is_space(*p)) ++p;
+    if (p < end && *p == '\\') {
+      const char* q = p + 1;
+      if (q < end && *q == '\r') ++q;
+      if (q < end && *q == '\n') {
+        p = q + 1;
+        continue;
+      }
+    }
+    return p;
+  }
+}
+
+// At a value's end: whitespace, the statement's end, a comment or `\` + EOL.
+inline bool at_separator(const char* p, const char* end) {
+  if (p >= end) return true;
+  char c = *p;
+  if (is_space(c) || c == '#' || c == '\n') return true;
+  if (c == '\\') {
+    const char* q = p + 1;
+    if (q < end && *q == '\r') ++q;
+    return q >= end || *q == '\n';
+  }
+  return false;
+}
+
+// True when the rest of the statement is empty or a comment.
+inline bool at_statement_end(const char* p, const char* end) {
+  p = skip_ws(p, end);
+  return p >= end || *p == '#';
+}
+
+// The token starting at p (up to whitespace), for messages, at most 40 chars.
+inline std::string token_text(const char* p, const char* end) {
+  const char* q = p;
+  while (q < end && !is_space(*q) && *q != '\n' && q - p < 40) ++q;
+  return std::string(p, q);
+}
+
+// Thrown-message helper bound to a file name.
+struct Where {
+  const std::string* file;
+  [[noreturn]] void fail(long line, const std::string& msg) const { throw InputError(located(*file, line, msg)); }
+};
+
+inline bool starts_with_ci(const char* p, const char* end, const char* word) {
+  for (; *word; ++word, ++p) {
+    if (p >= end) return false;
+    char c = *p;
+    if (c >= 'a' && c <= 'z') c = char(c - 32);
+    if (c != *word) return false;
+  }
+  return true;
+}
+
+// Parses one number at p (after whitespace): from_chars plus a leading '+'.
+// On success returns the pointer after it; errors name the token.
+inline const char* parse_double(const char* p, const char* end, double& out, const Where& w, long line) {
+  p = skip_ws(p, end);
+  const char* tok = p;
+  if (p < end && *p == '+') ++p;
+  auto [q, ec] = std::from_chars(p, end, out, std::chars_format::general);
+  if (p < end && (*p == '+' || *p == '-') && tok != p) ec = std::errc::invalid_argument;  // "+-1"
+  if (ec == std::errc::result_out_of_range)
+    w.fail(line, "number out of range '" + token_text(tok, end) + "'");
+  if (ec != std::errc()) {
+    if (tok >= end || *tok == '#' || *tok == '\n') w.fail(line, "expected a number, found the end of the line");
+    w.fail(line, "malformed number '" + token_text(tok, end) + "'");
+  }
+  if (q - tok > kMaxNumberChars)
+    w.fail(line, "number too long (" + std::to_string(q - tok) + " characters, at most " +
+                     std::to_string(kMaxNumberChars) + ")");
+  if (q < end && *q == '#' &&
+      (starts_with_ci(q + 1, end, "IND") || starts_with_ci(q + 1, end, "INF") ||
+       starts_with_ci(q + 1, end, "QNAN") || starts_with_ci(q + 1, end, "SNAN")))
+    w.fail(line, "non-finite number '" + token_text(tok, end) + "' (MSVC notation) is not accepted");
+  if (!at_separator(q, end)) w.fail(line, "malformed number '" + token_text(tok, end) + "'");
+  if (!std::isfinite(out)) w.fail(line, "non-finite number '" + token_text(tok, end) + "' is not accepted");
+  return q;
+}
+
+// Reads up to `max` numbers into out; returns how many were read. Stops at
+// the statement end or a comment; anything else that is not a number is an
+// error, as is a (max+1)-th number.
+inline int parse_numbers(const char*& p, const char* end, double* out, int max, const Where& w, long line,
+                         const char* what) {
+  int n = 0;
+  for (;;) {
+    p = skip_ws(p, end);
+    if (p >= end || *p == '#') return n;
+    if (n == max) w.fail(line, std::string(what) + ": too many values (at most " + std::to_string(max) + ")");
+    p = parse_double(p, end, out[n], w, line);
+    ++n;
+  }
+}
+
+// The rest of the statement as a name: leading/trailing whitespace removed,
+// inner whitespace kept, cut at a '#' that follows whitespace (a comment),
+// escaped line breaks kept verbatim (rare; names rarely span lines).
+inline std::string_view rest_as_name(const char* p, const char* end) {
+  p = skip_ws(p, end);
+  const char* q = p;
+  while (q < end && *q != '\n') {
+    if (*q == '#' && (q == p || is_space(q[-1]))) break;
+    ++q;
+  }
+  while (q > p && (is_space(q[-1]) || q[-1] == '\\')) --q;
+  return {p, size_t(q - p)};
+}
+
+// Checks the encoding of a whole text: UTF-16 BOMs and NUL bytes are errors;
+// returns the text without a UTF-8 BOM.
+inline std::string_view check_encoding(std::string_view text, const std::string& name) {
+  if (text.size() >= 2 && ((unsigned char)text[0] == 0xFE && (unsigned char)text[1] == 0xFF))
+    throw InputError(located(name, 1, "UTF-16 (big-endian BOM) is not supported: convert the file to UTF-8"));
+  if (text.size() >= 2 && ((unsigned char)text[0] == 0xFF && (unsigned char)text[1] == 0xFE))
+    throw InputError(located(name, 1, "UTF-16 (little-endian BOM) is not supported: convert the file to UTF-8"));
+  if (text.size() >= 3 && (unsigned char)text[0] == 0xEF && (unsigned char)text[1] == 0xBB &&
+      (unsigned char)text[2] == 0xBF)
+    text.remove_prefix(3);
+  if (const void* z = std::memchr(text.data(), 0, text.size())) {
+    const char* zp = static_cast<const char*>(z);
+    long line = 1;
+    for (const char* c = text.data(); c < zp; ++c) line += (*c == '\n');
+    throw InputError(located(name, line, "NUL byte in a text file (UTF-16 without BOM, or binary?)"));
+  }
+  return text;
+}
+
+}  // namespace ra::objtext

@@ -1,0 +1,293 @@
+#include "polymesh_io.h"
+
+#include <charconv>
+#include <cstring>
+
+#include "atomic_file.h"
+#include "errors.h"
+#include "mesh.h"
+
+namespace ra {
+namespace {
+
+// A whitespace tokenizer over a text that tracks line numbers.
+struct Tokens {
+  const char* p;
+  const char* e;
+  const std::string& name;
+  long line = 1;
+
+  [[noreturn]] void fail(const std::string& msg) const { throw InputError(located(name, line, msg)); }
+  // Skips spaces (and newlines when `lines`), and '#' comments.
+  void skip(bool lines) {
+    for (;;) {
+      while (p < e && (*p == ' ' || *p == '\t' || *p == '\r' || (lines && *p == '\n'))) line += (*p++ == '\n');
+      if (p < e && *p == '#') {
+        while (p < e && *p != '\n') ++p;
+        continue;
+      }
+      return;
+    }
+  }
+  bool at_eol() {
+    skip(false);
+    return p >= e || *p == '\n';
+  }
+  void next_line() {
+    while (p < e && *p != '\n') ++p;
+    if (p < e) ++p, ++line;
+  }
+  std::string_view word() {
+    skip(true);
+    const char* b = p;
+    while (p < e && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n') ++p;
+    return {b, size_t(p - b)};
+  }
+  template <class T>
+  T number(const char* what) {
+    skip(true);
+    T v{};
+    const char* b = p;
+    if (p < e && *p == '+') ++p;
+    auto [q, ec] = std::from_chars(p, e, v);
+    if (ec != std::errc() || (q < e && *q != ' ' && *q != '\t' && *q != '\r' && *q != '\n'))
+      fail(std::string("malformed ") + what + " '" + std::string(b, size_t(std::min<ptrdiff_t>(e - b, 20))) + "'");
+    p = q;
+    return v;
+  }
+};
+
+void check_faces(PolyMesh& m, const std::string& name) {
+  const long n = long(m.positions.size());
+  for (size_t f = 0; f + 1 < m.face_start.size(); ++f)
+    for (int i = m.face_start[f]; i < m.face_start[f + 1]; ++i)
+      if (m.indices[size_t(i)] < 0 || m.indices[size_t(i)] >= n)
+        throw InputError(located(name, 0, "face " + std::to_string(f) + " has vertex index " +
+                                              std::to_string(m.indices[size_t(i)]) + " out of range (" +
+                                              std::to_string(n) + " vertices)"));
+}
+
+enum class PlyType { I8, U8, I16, U16, I32, U32, F32, F64 };
+struct PlyProp {
+  std::string name;
+  PlyType type;
+  bool list = false;
+  PlyType count_type = PlyType::U8;
+};
+struct PlyElement {
+  std::string name;
+  long count;
+  std::vector<PlyProp> props;
+};
+
+bool ply_type(std::string_view s, PlyType& t) {
+  static const std::pair<const char*, PlyType> names[] = {
+      {"char", PlyType::I8},    {"int8", PlyType::I8},     {"uchar", PlyType::U8},   {"uint8", PlyType::U8},
+      {"short", PlyType::I16},  {"int16", PlyType::I16},   {"ushort", PlyType::U16}, {"uint16", PlyType::U16},
+      {"int", PlyType::I32},    {"int32", PlyType::I32},   {"uint", PlyType::U32},   {"uint32", PlyType::U32},
+      {"float", PlyType::F32},  {"float32", PlyType::F32}, {"double", PlyType::F64}, {"float64", PlyType::F64}};
+  for (auto& [n, v] : names)
+    if (s == n) return t = v, true;
+  return false;
+}
+int ply_size(PlyType t) {
+  switch (t) {
+    case PlyType::I8: case PlyType::U8: return 1;
+    case PlyType::I16: case PlyType::U16: return 2;
+    case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
+    default: return 8;
+  }
+}
+
+// Reads one binary value.
+struct BinReader {
+  const unsigned char* p;
+  const unsigned char* b;
+  const unsigned char* e;
+  bool big;
+  const std::string& name;
+  double get(PlyType t) {
+    const int n = ply_size(t);
+    if (e - p < n)
+      throw InputError(located(name, 0, "byte " + std::to_string(p - b) + ": file ends inside the data"));
+    unsigned char buf[8];
+    std::memcpy(buf, p, size_t(n));
+    if (big) std::reverse(buf, buf + n);
+    p += n;
+    switch (t) {
+      case PlyType::I8: { int8_t v; std::memcpy(&v, buf, 1); return v; }
+      case PlyType::U8: return buf[0];
+      case PlyType::I16: { int16_t v; std::memcpy(&v, buf, 2); return v; }
+      case PlyType::U16: { uint16_t v; std::memcpy(&v, buf, 2); return v; }
+      case PlyType::I32: { int32_t v; std::memcpy(&v, buf, 4); return v; }
+      case PlyType::U32: { uint32_t v; std::memcpy(&v, buf, 4); return v; }
+      case PlyType::F32: { float v; std::memcpy(&v, buf, 4); return v; }
+      default: { double v; std::memcpy(&v, buf, 8); return v; }
+    }
+  }
+};
+
+}  // namespace
+
+PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
+  Tokens t{bytes.data(), bytes.data() + bytes.size(), name};
+  if (t.word() != "ply") t.fail("not a PLY file (no 'ply' magic)");
+  std::vector<PlyElement> elements;
+  int format = -1;  // 0 ascii, 1 little, 2 big
+  for (;;) {
+    if (t.p >= t.e) t.fail("no end_header");
+    const std::string_view k = t.word();
+    if (k == "format") {
+      const auto f = t.word();
+      format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
+      if (format < 0) t.fail("unknown PLY format '" + std::string(f) + "'");
+      t.next_line();
+    } else if (k == "comment" || k == "obj_info") {
+      t.next_line();
+    } else if (k == "element") {
+      PlyElement el;
+      el.name = std::string(t.word());
+      el.count = t.number<long>("element count");
+      if (el.count < 0 || el.count > (1L << 31)) t.fail("element count out of range");
+      elements.push_back(std::move(el));
+      t.next_line();
+    } else if (k == "property") {
+      if (elements.empty()) t.fail("property before any element");
+      PlyProp pr;
+      auto ty = t.word();
+      if (ty == "list") {
+        pr.list = true;
+        if (!ply_type(t.word(), pr.count_type)) t.fail("unknown list count type");
+        ty = t.word();
+      }
+      if (!ply_type(ty, pr.type)) t.fail("unknown property type '" + std::string(ty) + "'");
+      pr.name = std::string(t.word());
+      elements.back().props.push_back(std::move(pr));
+      t.next_line();
+    } else if (k == "end_header") {
+      t.next_line();
+      break;
+    } else {
+      t.fail("unknown PLY header line '" + std::string(k) + "'");
+    }
+  }
+  if (format < 0) t.fail("no format line");
+  PolyMesh m;
+  m.face_start.push_back(0);
+  BinReader br{reinterpret_cast<const unsigned char*>(t.p), reinterpret_cast<const unsigned char*>(bytes.data()),
+               reinterpret_cast<const unsigned char*>(bytes.data() + bytes.size()), format == 2, name};
+  for (const auto& el : elements) {
+    const bool is_vertex = el.name == "vertex", is_face = el.name == "face";
+    int ix = -1, iy = -1, iz = -1, ilist = -1;
+    for (size_t i = 0; i < el.props.size(); ++i) {
+      const auto& n = el.props[i].name;
+      if (n == "x") ix = int(i);
+      if (n == "y") iy = int(i);
+      if (n == "z") iz = int(i);
+      if (el.props[i].list && (n == "vertex_indices" || n == "vertex_index")) ilist = int(i);
+    }
+    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) t.fail("vertex element without x, y, z");
+    if (is_face && ilist < 0) t.fail("face element without vertex_indices");
+    if (is_vertex) m.positions.reserve(size_t(el.count));
+    for (long r = 0; r < el.count; ++r) {
+      Vec3d pos;
+      for (size_t i = 0; i < el.props.size(); ++i) {
+        const auto& pr = el.props[i];
+        auto value = [&](PlyType ty) { return format == 0 ? t.number<double>("PLY value") : br.get(ty); };
+        if (pr.list) {
+          const double c = value(pr.count_type);
+          if (c < 0 || c > 1e6 || c != double(long(c))) t.fail("bad list count");
+          for (long j = 0; j < long(c); ++j) {
+            const double v = value(pr.type);
+            if (int(i) == ilist) m.indices.push_back(int(v));
+          }
+          if (int(i) == ilist) {
+            if (c < 3) t.fail("face with fewer than 3 vertices");
+            m.face_start.push_back(int(m.indices.size()));
+          }
+        } else {
+          const double v = value(pr.type);
+          if (int(i) == ix) pos.x = v;
+          if (int(i) == iy) pos.y = v;
+          if (int(i) == iz) pos.z = v;
+        }
+      }
+      if (is_vertex) m.positions.push_back(pos);
+      if (format == 0 && !t.at_eol()) t.fail("extra values on a PLY data line");
+      if (format == 0) t.next_line();
+    }
+  }
+  check_faces(m, name);
+  return m;
+}
+
+PolyMesh parse_off(std::string_view text, const std::string& name) {
+  Tokens t{text.data(), text.data() + text.size(), name};
+  const std::string_view magic = t.word();
+  if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF") t.fail("not an OFF file (no OFF header)");
+  const long nv = t.number<long>("vertex count"), nf = t.number<long>("face count");
+  t.number<long>("edge count");
+  if (nv < 0 || nf < 0 || nv > (1L << 31) || nf > (1L << 31)) t.fail("counts out of range");
+  t.next_line();
+  PolyMesh m;
+  m.positions.reserve(size_t(nv));
+  for (long i = 0; i < nv; ++i) {
+    t.skip(true);
+    Vec3d p;
+    p.x = t.number<double>("coordinate");
+    p.y = t.number<double>("coordinate");
+    p.z = t.number<double>("coordinate");
+    m.positions.push_back(p);
+    t.next_line();
+  }
+  m.face_start.push_back(0);
+  for (long f = 0; f < nf; ++f) {
+    t.skip(true);
+    const long n = t.number<long>("face size");
+    if (n < 3 || n > 1000000) t.fail("face with " + std::to_string(n) + " vertices");
+    for (long j = 0; j < n; ++j) m.indices.push_back(t.number<int>("vertex index"));
+    m.face_start.push_back(int(m.indices.size()));
+    t.next_line();  // colour values, if any
+  }
+  check_faces(m, name);
+  return m;
+}
+
+PolyMesh read_ply(const std::filesystem::path& file) {
+  return parse_ply(read_file_bytes(file, kMaxObjFileBytes), file.string());
+}
+PolyMesh read_off(const std::filesystem::path& file) {
+  return parse_off(read_file_bytes(file, kMaxObjFileBytes), file.string());
+}
+
+std::string to_obj_text(const PolyMesh& m, const std::string& comment) {
+  std::string out;
+  out.reserve(m.positions.size() * 40 + m.indices.size() * 8);
+  if (!comment.empty()) out += "# " + comment + "\n";
+  char buf[64];
+  for (const auto& p : m.positions) {
+    out += 'v';
+    for (int k = 0; k < 3; ++k) {
+      out += ' ';
+      auto r = std::to_chars(buf, buf + sizeof buf, p[k]);
+      out.append(buf, r.ptr);
+    }
+    out += '\n';
+  }
+  for (size_t f = 0; f < m.faces(); ++f) {
+    out += 'f';
+    for (int i = m.face_start[f]; i < m.face_start[f + 1]; ++i) {
+      out += ' ';
+      auto r = std::to_chars(buf, buf + sizeof buf, m.indices[size_t(i)] + 1);
+      out.append(buf, r.ptr);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+void write_obj(const PolyMesh& m, const std::filesystem::path& out, const std::string& comment) {
+  write_text_atomically(out, to_obj_text(m, comment));
+}
+
+}  // namespace ra

@@ -1,0 +1,94 @@
+#include "texture.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+
+#include "errors.h"
+
+namespace ra {
+namespace {
+
+// POV-Ray's wrap(): into [0, m).
+double wrap(double v, double m) {
+  v = std::fmod(v, m);
+  if (v < 0) v += m;
+  return v >= m ? 0.0 : v;  // -tiny + m may round up to m
+}
+
+int wrap_int(int i, int n) {
+  i %= n;
+  return i < 0 ? i + n : i;
+}
+
+}  // namespace
+
+Vec3d Texture::texel(int x, int y) const {
+  const float* p = &rgb[(std::size_t(wrap_int(y, height)) * width + wrap_int(x, width)) * 3];
+  return {p[0], p[1], p[2]};
+}
+
+void Texture::set(int x, int y, const Vec3d& c) {
+  float* p = &rgb[(std::size_t(y) * width + x) * 3];
+  p[0] = float(c.x);
+  p[1] = float(c.y);
+  p[2] = float(c.z);
+}
+
+void Texture::image_coords(double u, double v, double& x, double& y) const {
+  const double w = width, h = height;
+  x = wrap(std::fmod(u * w, w) + kPovImageEpsilon, w);
+  y = wrap(-(std::fmod(v * h, h) + kPovImageEpsilon), h);
+}
+
+Vec3d Texture::nearest_xy(double x, double y) const { return texel(int(x), int(y)); }
+
+Vec3d Texture::bilinear_xy(double x, double y) const {
+  x += 0.5;
+  y += 0.5;
+  const int ix = int(x), iy = int(y);
+  const double p = x - ix, q = y - iy;
+  return texel(ix, iy) * (p * q) + texel(ix - 1, iy) * ((1 - p) * q) + texel(ix, iy - 1) * (p * (1 - q)) +
+         texel(ix - 1, iy - 1) * ((1 - p) * (1 - q));
+}
+
+Vec3d Texture::nearest(double u, double v) const {
+  double x, y;
+  image_coords(u, v, x, y);
+  return nearest_xy(x, y);
+}
+
+Vec3d Texture::bilinear(double u, double v) const {
+  double x, y;
+  image_coords(u, v, x, y);
+  return bilinear_xy(x, y);
+}
+
+Texture load_texture(const std::filesystem::path& file) {
+  auto in = OIIO::ImageInput::open(file.string());
+  if (!in) throw InputError(located(file.string(), 0, "cannot read texture: " + OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  const int nc = spec.nchannels;
+  std::vector<float> all(std::size_t(spec.width) * spec.height * nc);
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
+    throw InputError(located(file.string(), 0, "cannot read texture: " + in->geterror()));
+  in->close();
+  Texture t(spec.width, spec.height);
+  for (std::size_t i = 0, n = std::size_t(spec.width) * spec.height; i < n; ++i)
+    for (int c = 0; c < 3; ++c) t.rgb[i * 3 + c] = all[i * nc + (nc >= 3 ? c : 0)];
+  return t;
+}
+
+const Texture& TextureCache::load(const std::filesystem::path& file) {
+  const std::string key = file.lexically_normal().string();
+  auto& slot = by_file_[key];
+  if (!slot) slot = std::make_unique<Texture>(load_texture(file));
+  return *slot;
+}
+
+const Texture* TextureCache::find(const std::filesystem::path& file) const {
+  auto it = by_file_.find(file.lexically_normal().string());
+  return it == by_file_.end() ? nullptr : it->second.get();
+}
+
+}  // namespace ra

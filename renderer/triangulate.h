@@ -1,0 +1,28 @@
+// Ear clipping of one planar polygon (Meisters 1975, "Polygons have ears";
+// O(n^2) for convex polygons, O(n^3) worst case). The polygon is projected
+// onto the coordinate plane most perpendicular to its Newell normal, in
+// coordinates relative to its first vertex so that large offsets do not eat
+// the precision (tinyobjloader #295 lost faces that way).
+// Guarantee: always n-2 triangles, each (a, b, c) listed in the polygon's
+// own winding; for a simple polygon (convex or concave) they tile it exactly.
+// For a degenerate or self-intersecting one, when no ear is left the first
+// remaining corner is cut anyway (a fan), so the count still holds.
+// A convex polygon comes out as the fan (0,1,2), (0,2,3), ...
+#pragma once
+#include <array>
+#include <vector>
+
+#include "vec.h"
+
+namespace ra {
+
+struct EarClipScratch {
+  std::vector<int> remaining;
+  std::vector<std::array<double, 2>> q;
+};
+
+// Appends the triangles of polygon pts[0..n) as index triples into `out`.
+void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out,
+                         EarClipScratch& scratch);
+
+}  // namespace ra
