@@ -7,7 +7,9 @@
 #include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "golden.h"
 #include "image_compare.h"
+#include "pov_explain.h"
 #include "pov_export.h"
 #include "pov_runner.h"
 #include "pov_tolerance.h"
@@ -22,11 +24,17 @@ constexpr int kSkipped = 77;
 struct Args {
   std::string scene, json_out, diff_out, ours_out, pov_out, tolerance;
   int bits = 8, width = 0, height = 0, threads = 0;
-  bool keep = false, skip_inexpressible = false;
+  bool keep = false, skip_inexpressible = false, explain = false;
 };
 
 void run(const Args& a) {
   if (a.bits != 8 && a.bits != 16) throw ra::InputError("--bits must be 8 or 16");
+  if (a.skip_inexpressible)
+    if (const auto missing = ra::missing_cache_inputs(a.scene); !missing.empty()) {
+      std::cout << "skipped: " << a.scene << " needs " << missing[0].string()
+                << ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)\n";
+      throw ra::cli::ExitCode{kSkipped};
+    }
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
   if (a.height > 0) scene.height = a.height;
@@ -53,6 +61,14 @@ void run(const Args& a) {
   const ra::PovVerdict v = ra::judge(c, tol);
   std::cout << "scene: " << a.scene << "\n" << ra::summary(c);
   for (const auto& line : v.lines) std::cout << line << "\n";
+  std::vector<ra::PixelExplanation> explained;
+  if (a.explain && !c.differences.empty()) {
+    std::cout << "likely causes (--explain):\n";
+    explained = ra::explain_differences(scene, ours, pov.image, c, opt);
+    for (const auto& e : explained)
+      std::cout << "  (" << e.x << ", " << e.y << ") " << e.levels << " levels: "
+                << (e.cause.empty() ? "none of the known causes" : e.cause) << "\n";
+  }
   if (!tol.notes.empty()) std::cout << "notes (" << tol.file.string() << "): " << tol.notes << "\n";
   if (!pov.dir.empty()) std::cout << "POV-Ray's working directory: " << pov.dir.string() << "\n";
   if (!a.diff_out.empty()) {
@@ -67,6 +83,11 @@ void run(const Args& a) {
     j["tolerance_file"] = tol.file.string();
     j["within_tolerance"] = v.pass;
     j["verdict"] = v.lines;
+    if (a.explain) {
+      nlohmann::json ex = nlohmann::json::array();
+      for (const auto& e : explained) ex.push_back({{"x", e.x}, {"y", e.y}, {"levels", e.levels}, {"cause", e.cause}});
+      j["explanations"] = ex;
+    }
     ra::write_text_atomically(a.json_out, j.dump(2) + "\n");
   }
   if (!v.pass)
@@ -89,9 +110,12 @@ void setup(CLI::App& app) {
   cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--threads", args->threads, "Threads for our render (default: all cores)");
+  cmd->add_flag("--explain", args->explain,
+                "Test each differing pixel for the known causes (float32 mesh data, POV's shadow cache)");
   cmd->add_flag("--keep-pov-dir", args->keep, "Keep POV-Ray's working directory (scene.pov, ini, images)");
   cmd->add_flag("--skip-inexpressible", args->skip_inexpressible,
-                "Exit 77 (a skip for ctest) with the reason when POV-Ray cannot express the scene");
+                "Exit 77 (a skip for ctest) with the reason when POV-Ray cannot express the scene or a ${cache} "
+                "input is missing");
   cmd->callback([args] { run(*args); });
 }
 

@@ -3,12 +3,14 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
 
 #include "atomic_file.h"
 #include "errors.h"
 #include "render.h"
+#include "scene_mesh.h"
 
 namespace ra {
 namespace {
@@ -35,8 +37,14 @@ std::string read_bytes(const fs::path& p) {
   return ss.str();
 }
 
+// A path as the manifest records it: relative to the repository, or
+// "${cache}/..." for the cache (whose place differs between machines).
 std::string relative_to(const fs::path& p, const fs::path& root) {
   const fs::path a = fs::weakly_canonical(p), r = fs::weakly_canonical(root);
+  if (const auto cache = expand_cache_prefix("${cache}/x")) {
+    const fs::path in_cache = a.lexically_relative(fs::weakly_canonical(cache->parent_path()));
+    if (!in_cache.empty() && *in_cache.begin() != "..") return "${cache}/" + in_cache.generic_string();
+  }
   const fs::path rel = a.lexically_relative(r);
   if (rel.empty() || *rel.begin() == "..") return a.generic_string();
   return rel.generic_string();
@@ -57,9 +65,15 @@ std::vector<fs::path> mtllibs(const fs::path& obj) {
 }
 
 // The settings a golden is rendered with, as recorded in the manifest.
+// The render defaults (RenderOptions), as recorded in the manifest.
 json default_settings() {
-  return {{"triangle_method", "moller"}, {"sphere_method", "stable"}, {"precision", "double"},
-          {"self_intersection", "pov"},  {"accel", "none"},           {"spp", 1}};
+  const RenderOptions o;
+  return {{"triangle_method", o.triangle_method},
+          {"sphere_method", o.sphere_method},
+          {"precision", o.use_double ? "double" : "float"},
+          {"self_intersection", self_intersection_name(o.self_intersection)},
+          {"accel", accel_name(o.accel)},
+          {"spp", o.samples_per_axis * o.samples_per_axis}};
 }
 
 RenderOptions options_from(const json& s) {
@@ -137,6 +151,23 @@ std::map<std::string, std::string> scene_inputs(const Scene& scene, const fs::pa
   }
   std::map<std::string, std::string> out;
   for (const auto& f : files) out[relative_to(f, root)] = fnv1a64_hex(read_bytes(f));
+  return out;
+}
+
+std::vector<fs::path> missing_cache_inputs(const fs::path& scene_file) {
+  std::vector<fs::path> out;
+  std::function<void(const json&)> walk = [&](const json& j) {
+    if (j.is_string()) {
+      if (auto p = expand_cache_prefix(j.get<std::string>()); p && !fs::exists(*p)) out.push_back(*p);
+    } else if (j.is_structured()) {
+      for (const auto& e : j) walk(e);
+    }
+  };
+  try {
+    walk(json::parse(read_bytes(scene_file)));
+  } catch (const json::exception&) {
+    // load_scene reports a malformed scene with its line.
+  }
   return out;
 }
 
@@ -269,6 +300,8 @@ std::string GoldenSet::bless(const std::string& name) {
     } else {
       what = name + ": size changed to " + std::to_string(g.width) + "x" + std::to_string(g.height);
     }
+    if (old->second.settings != g.settings)
+      what += "; render settings changed from " + old->second.settings.dump() + " to " + g.settings.dump();
     if (old->second.inputs_hash != g.inputs_hash)
       what += "; inputs changed: " + changed_inputs(old->second.inputs, g.inputs);
     else

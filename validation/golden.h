@@ -37,6 +37,11 @@ struct GoldenEntry {
 std::map<std::string, std::string> scene_inputs(const Scene& scene, const std::filesystem::path& root);
 std::string combined_hash(const std::map<std::string, std::string>& inputs);
 
+// The "${cache}/..." files a scene file names that do not exist (the teapot
+// ci/main.sh generates, the corpus ci/fetch-corpus.sh fetches): a test of
+// such a scene is skipped, saying so, rather than failed.
+std::vector<std::filesystem::path> missing_cache_inputs(const std::filesystem::path& scene_file);
+
 class GoldenSet {
  public:
   // Reads root/golden/manifest.json (an empty set when there is none).
