@@ -82,6 +82,31 @@ TEST(ExportPovCli, HostileSceneFileNameStaysInertAndPovRayWritesNothing) {
   fs::remove_all(dir);
 }
 
+// The hostile texture name, in a real scene file with a textured
+// OBJ: export-pov and compare (which runs POV-Ray on the export) both work,
+// the SDL holds no directive, and POV-Ray creates no file.
+TEST(ExportPovCli, HostileTextureNameInASceneFileCannotInjectSdl) {
+  const fs::path dir = temp_dir("hostile-texture");
+  const fs::path target = dir / "pwn";
+  const std::string name = "x.png\" } #fopen F \"" + target.string() + "\" write #write(F,\"x\") #declare A = {\"";
+  fs::create_directories((dir / name).parent_path());
+  fs::copy_file(std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/textures/uv-grid.png", dir / name);
+  fs::copy_file(std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/meshes/quad.obj", dir / "quad.obj");
+  nlohmann::json scene = {{"width", 48}, {"height", 36}, {"camera", {{"position", {0, 0, 3}}}},
+                          {"objects", {{{"mesh", "quad.obj"}, {"material", {{"texture", {{"file", name}}}}}}}}};
+  std::ofstream(dir / "s.json") << scene.dump();
+  Result r = run("export-pov " + (dir / "s.json").string() + " -o " + (dir / "out.pov").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string sdl = read(dir / "out.pov");
+  EXPECT_EQ(sdl.find("#fopen"), std::string::npos) << sdl;
+  EXPECT_NE(sdl.find("png \"out-tex0.png\""), std::string::npos) << sdl;
+  r = run("compare " + (dir / "s.json").string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("identical: true"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(target)) << "POV-Ray wrote " << target;
+  fs::remove_all(dir);
+}
+
 TEST(CompareCli, ReportsIdenticalAndWritesJsonAndDiff) {
   const fs::path dir = temp_dir("compare");
   const Result r = run("compare " + kSphereOnPlane + " --width 80 --height 60 --json " + (dir / "c.json").string() +
