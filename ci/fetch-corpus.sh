@@ -93,4 +93,22 @@ if [ ! -e ladder/dragon.obj ]; then
   "$exe" convert ladder/dragon.ply.tmp --from ply -o ladder/dragon.obj
   rm -f ladder/dragon.ply.tmp
 fi
+# The Utah teapot, tessellated by our own code from POV-Ray's teapot.inc
+# (Debian's povray-examples, taken with apt-get download: not installed).
+if [ ! -s generated/teapot.obj ]; then
+  if [ ! -x "$exe" ]; then
+    echo "fetch-corpus: $exe is not built (needed to tessellate the teapot); pass its path" >&2
+    exit 2
+  fi
+  inc=/usr/share/doc/povray/examples/advanced/teapot/teapot.inc
+  if [ ! -e "$inc" ]; then
+    deb povray-examples
+    inc="pkg/povray-examples/usr/share/doc/povray/examples/advanced/teapot/teapot.inc"
+  fi
+  say "generated/teapot.obj (rayaudit generate teapot, 8 x 8 quads per patch)"
+  mkdir -p generated
+  "$exe" generate teapot "$inc" -o generated/teapot.obj --steps 8
+else
+  say "have generated/teapot.obj"
+fi
 say "done: $cache"

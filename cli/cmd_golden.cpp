@@ -1,0 +1,78 @@
+// `rayaudit golden check|bless [SCENE...]`: golden images of scenes/*.json
+// (validation/golden.h). check renders and compares (exit 1 on any
+// difference, writing a diff image); bless rewrites goldens, only when asked.
+#include <iostream>
+
+#include "command.h"
+#include "errors.h"
+#include "golden.h"
+
+namespace {
+
+struct Args {
+  std::vector<std::string> scenes;
+  std::string root = RAYAUDIT_SOURCE_DIR;
+  std::string diff_dir;
+  bool skip_unavailable = false;
+};
+
+// "sphere-on-plane", "scenes/sphere-on-plane.json" -> "sphere-on-plane".
+std::vector<std::string> names_of(const std::vector<std::string>& given, const ra::GoldenSet& set) {
+  if (given.empty()) return set.all_names();
+  std::vector<std::string> out;
+  for (const auto& g : given) out.push_back(std::filesystem::path(g).stem().string());
+  return out;
+}
+
+void check(const Args& a) {
+  const ra::GoldenSet set(a.root);
+  const std::filesystem::path diff_dir =
+      a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden" : std::filesystem::path(a.diff_dir);
+  int failed = 0, skipped = 0;
+  const auto names = names_of(a.scenes, set);
+  for (const auto& n : names) {
+    const auto missing = ra::missing_cache_inputs(std::filesystem::path(a.root) / "scenes" / (n + ".json"));
+    if (a.skip_unavailable && !missing.empty()) {
+      std::cout << "skip " << n << ": needs " << missing[0].string()
+                << ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)\n";
+      ++skipped;
+      continue;
+    }
+    const auto r = set.check(n, diff_dir);
+    std::cout << (r.pass ? "ok   " : "FAIL ") << r.message << "\n";
+    failed += !r.pass;
+  }
+  if (failed)
+    throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
+                          " golden image(s) failed");
+  if (skipped == int(names.size())) throw ra::cli::ExitCode{77};
+}
+
+void bless(const Args& a) {
+  ra::GoldenSet set(a.root);
+  for (const auto& n : names_of(a.scenes, set)) std::cout << set.bless(n) << "\n";
+  set.save();
+}
+
+void setup(CLI::App& app) {
+  auto* cmd = app.add_subcommand("golden", "Check scenes against their golden images, or bless new ones");
+  cmd->require_subcommand(1);
+  auto add = [&](const char* name, const char* help, void (*fn)(const Args&)) {
+    auto args = std::make_shared<Args>();
+    auto* sub = cmd->add_subcommand(name, help);
+    sub->add_option("scenes", args->scenes, "Scene names or files (default: every scene in scenes/)");
+    sub->add_option("--root", args->root, "The repository (holding scenes/ and golden/)");
+    if (std::string(name) == "check") {
+      sub->add_option("--diff-dir", args->diff_dir, "Where to write diff images on failure (default /tmp/rayaudit-golden)");
+      sub->add_flag("--skip-unavailable", args->skip_unavailable,
+                    "Skip scenes whose ${cache} inputs are missing; exit 77 when all were skipped");
+    }
+    sub->callback([args, fn] { fn(*args); });
+  };
+  add("check", "Render each scene and compare with its golden image (exit 1 on any difference)", check);
+  add("bless", "Render each scene and record it as its golden image, printing what changed", bless);
+}
+
+ra::cli::Registrar reg(60, setup);
+
+}  // namespace

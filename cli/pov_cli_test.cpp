@@ -1,0 +1,159 @@
+// export-pov, compare and golden run as a user runs them.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "image.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string out;
+};
+
+Result run(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + " " + std::string(RAYAUDIT_EXE) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WEXITSTATUS(status), out};
+}
+
+fs::path temp_dir(const std::string& tag) {
+  const fs::path d = fs::path("/tmp") / ("rayaudit-pov-cli-" + tag + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+const std::string kSphereOnPlane = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/sphere-on-plane.json";
+
+TEST(ExportPovCli, WritesSdlWithTheCameraAndEveryFinishTerm) {
+  const fs::path dir = temp_dir("export");
+  const Result r = run("export-pov " + kSphereOnPlane + " -o " + (dir / "s.pov").string() + " --ini " +
+                       (dir / "s.ini").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string sdl = read(dir / "s.pov");
+  EXPECT_NE(sdl.find("right <-1.3333333333333333,0,0>"), std::string::npos) << sdl;
+  EXPECT_NE(sdl.find("specular 0"), std::string::npos) << sdl;
+  EXPECT_NE(read(dir / "s.ini").find("File_Gamma=1.0"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(ExportPovCli, RefusesAnOutputThatIsNotPov) {
+  const Result r = run("export-pov " + kSphereOnPlane + " -o /tmp/x.png");
+  EXPECT_EQ(r.code, 2) << r.out;
+}
+
+// A scene file whose own name is SDL: it appears only in a comment, made safe.
+TEST(ExportPovCli, HostileSceneFileNameStaysInertAndPovRayWritesNothing) {
+  const fs::path dir = temp_dir("hostile");
+  const fs::path target = dir / "pwn";
+  const std::string name = "a\n#fopen F \"" + target.filename().string() + "\" write #write(F,\"x\")\n.json";
+  fs::copy_file(kSphereOnPlane, dir / name);
+  const Result r = run("export-pov '" + (dir / name).string() + "' -o " + (dir / "h.pov").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string sdl = read(dir / "h.pov");
+  EXPECT_EQ(sdl.find("#fopen"), std::string::npos) << sdl;
+  const Result c = run("compare '" + (dir / name).string() + "' --width 40 --height 30");
+  EXPECT_EQ(c.code, 0) << c.out;
+  EXPECT_FALSE(fs::exists(target));
+  EXPECT_FALSE(fs::exists(fs::current_path() / "pwn"));
+  fs::remove_all(dir);
+}
+
+// The issue's hostile texture name, in a real scene file with a textured
+// OBJ: export-pov and compare (which runs POV-Ray on the export) both work,
+// the SDL holds no directive, and POV-Ray creates no file.
+TEST(ExportPovCli, HostileTextureNameInASceneFileCannotInjectSdl) {
+  const fs::path dir = temp_dir("hostile-texture");
+  const fs::path target = dir / "pwn";
+  const std::string name = "x.png\" } #fopen F \"" + target.string() + "\" write #write(F,\"x\") #declare A = {\"";
+  fs::create_directories((dir / name).parent_path());
+  fs::copy_file(std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/textures/uv-grid.png", dir / name);
+  fs::copy_file(std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/meshes/quad.obj", dir / "quad.obj");
+  nlohmann::json scene = {{"width", 48}, {"height", 36}, {"camera", {{"position", {0, 0, 3}}}},
+                          {"objects", {{{"mesh", "quad.obj"}, {"material", {{"texture", {{"file", name}}}}}}}}};
+  std::ofstream(dir / "s.json") << scene.dump();
+  Result r = run("export-pov " + (dir / "s.json").string() + " -o " + (dir / "out.pov").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  const std::string sdl = read(dir / "out.pov");
+  EXPECT_EQ(sdl.find("#fopen"), std::string::npos) << sdl;
+  EXPECT_NE(sdl.find("png \"out-tex0.png\""), std::string::npos) << sdl;
+  r = run("compare " + (dir / "s.json").string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("identical: true"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(target)) << "POV-Ray wrote " << target;
+  fs::remove_all(dir);
+}
+
+TEST(CompareCli, ReportsIdenticalAndWritesJsonAndDiff) {
+  const fs::path dir = temp_dir("compare");
+  const Result r = run("compare " + kSphereOnPlane + " --width 80 --height 60 --json " + (dir / "c.json").string() +
+                       " --diff " + (dir / "d.png").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("identical: true"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(read(dir / "c.json"));
+  for (const char* key : {"pixels", "over_1", "over_4", "max_error", "psnr", "identical"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["pixels"], 80 * 60);
+  EXPECT_TRUE(j["identical"].get<bool>());
+  EXPECT_EQ(ra::read_image(dir / "d.png").width, 80);
+  fs::remove_all(dir);
+}
+
+TEST(CompareCli, SaysClearlyWhenPovRayIsMissing) {
+  const Result r = run("compare " + kSphereOnPlane, "env PATH=/nonexistent");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("POV-Ray is not installed"), std::string::npos) << r.out;
+}
+
+TEST(CompareCli, SkipsWithItsReasonWhenPovCannotExpressTheScene) {
+  const fs::path dir = temp_dir("bump");
+  ra::Image img(2, 2);
+  ra::write_image(dir / "b.png", img);
+  std::ofstream(dir / "s.json") << R"({"objects": [{"sphere": {}, "material": {"bump": {"file": "b.png"}}}]})";
+  Result r = run("compare " + (dir / "s.json").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  r = run("compare " + (dir / "s.json").string() + " --skip-inexpressible");
+  EXPECT_EQ(r.code, 77) << r.out;
+  EXPECT_NE(r.out.find("bump variant \"height\""), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(GoldenCli, CheckWithoutAGoldenFailsAndBlessRecordsOne) {
+  const fs::path dir = temp_dir("golden");
+  fs::create_directories(dir / "scenes");
+  fs::copy_file(kSphereOnPlane, dir / "scenes" / "s.json");
+  Result r = run("golden check --root " + dir.string());
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.out.find("rayaudit golden bless s"), std::string::npos) << r.out;
+  r = run("golden bless s --root " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("new golden"), std::string::npos) << r.out;
+  r = run("golden check --root " + dir.string());
+  EXPECT_EQ(r.code, 0) << r.out;
+  fs::remove_all(dir);
+}
+
+}  // namespace

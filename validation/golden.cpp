@@ -1,0 +1,328 @@
+#include "golden.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+
+#include "atomic_file.h"
+#include "errors.h"
+#include "render.h"
+#include "scene_mesh.h"
+
+namespace ra {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+std::string fnv1a64_hex(const std::string& bytes) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw InputError(located(p.string(), 0, "cannot read"));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A path as the manifest records it: relative to the repository, or
+// "${cache}/..." for the cache (whose place differs between machines).
+std::string relative_to(const fs::path& p, const fs::path& root) {
+  const fs::path a = fs::weakly_canonical(p), r = fs::weakly_canonical(root);
+  if (const auto cache = expand_cache_prefix("${cache}/x")) {
+    const fs::path in_cache = a.lexically_relative(fs::weakly_canonical(cache->parent_path()));
+    if (!in_cache.empty() && *in_cache.begin() != "..") return "${cache}/" + in_cache.generic_string();
+  }
+  const fs::path rel = a.lexically_relative(r);
+  if (rel.empty() || *rel.begin() == "..") return a.generic_string();
+  return rel.generic_string();
+}
+
+// The mtllib files an OBJ names (resolved beside it), those that exist.
+std::vector<fs::path> mtllibs(const fs::path& obj) {
+  std::vector<fs::path> out;
+  std::ifstream in(obj);
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream ls(line);
+    std::string word;
+    if (!(ls >> word) || word != "mtllib") continue;
+    for (std::string f; ls >> f;)
+      if (fs::exists(obj.parent_path() / f)) out.push_back(obj.parent_path() / f);
+  }
+  return out;
+}
+
+// The settings a golden is rendered with, as recorded in the manifest.
+// The render defaults (RenderOptions), as recorded in the manifest.
+json default_settings() {
+  const RenderOptions o;
+  return {{"triangle_method", o.triangle_method},
+          {"sphere_method", o.sphere_method},
+          {"precision", o.use_double ? "double" : "float"},
+          {"self_intersection", self_intersection_name(o.self_intersection)},
+          {"accel", accel_name(o.accel)},
+          {"spp", o.samples_per_axis * o.samples_per_axis}};
+}
+
+RenderOptions options_from(const json& s) {
+  RenderOptions o;
+  o.triangle_method = s.value("triangle_method", o.triangle_method);
+  o.sphere_method = s.value("sphere_method", o.sphere_method);
+  o.use_double = s.value("precision", std::string("double")) == "double";
+  if (auto si = parse_self_intersection(s.value("self_intersection", std::string("pov")))) o.self_intersection = *si;
+  if (auto a = parse_accel(s.value("accel", std::string("none")))) o.accel = *a;
+  const int spp = s.value("spp", 1);
+  o.samples_per_axis = std::max(1, int(std::lround(std::sqrt(double(spp)))));
+  o.progress = false;
+  return o;
+}
+
+json to_json(const GoldenEntry& e) {
+  return {{"name", e.name},     {"scene", e.scene},       {"image", e.image},   {"width", e.width},
+          {"height", e.height}, {"bits", e.bits},         {"settings", e.settings},
+          {"inputs_hash", e.inputs_hash},                 {"inputs", e.inputs}};
+}
+
+GoldenEntry entry_from(const json& j) {
+  GoldenEntry e;
+  e.name = j.at("name").get<std::string>();
+  e.scene = j.at("scene").get<std::string>();
+  e.image = j.at("image").get<std::string>();
+  e.width = j.at("width").get<int>();
+  e.height = j.at("height").get<int>();
+  e.bits = j.value("bits", 8);
+  e.settings = j.value("settings", default_settings());
+  e.inputs_hash = j.at("inputs_hash").get<std::string>();
+  e.inputs = j.value("inputs", std::map<std::string, std::string>{});
+  return e;
+}
+
+// Which inputs differ between what was blessed and what is there now.
+std::string changed_inputs(const std::map<std::string, std::string>& then,
+                           const std::map<std::string, std::string>& now) {
+  std::string out;
+  auto add = [&](const std::string& s) { out += (out.empty() ? "" : ", ") + s; };
+  for (const auto& [f, h] : now) {
+    auto it = then.find(f);
+    if (it == then.end()) add(f + " (new)");
+    else if (it->second != h) add(f + " (changed)");
+  }
+  for (const auto& [f, h] : then)
+    if (!now.count(f)) add(f + " (no longer used)");
+  return out;
+}
+
+void golden_size(int w, int h, int& gw, int& gh) {
+  const double s = std::min(1.0, double(kGoldenMaxSize) / double(std::max(w, h)));
+  gw = std::max(1, int(std::lround(w * s)));
+  gh = std::max(1, int(std::lround(h * s)));
+}
+
+}  // namespace
+
+std::map<std::string, std::string> scene_inputs(const Scene& scene, const fs::path& root) {
+  std::set<fs::path> files{scene.file};
+  auto material_files = [&](const Material& m) {
+    if (m.texture) files.insert(m.texture->file);
+    if (m.bump) files.insert(m.bump->file);
+  };
+  for (const auto& o : scene.objects) {
+    material_files(o.material);
+    if (o.kind != Object::Kind::mesh || !o.mesh) continue;
+    for (const auto& m : o.mesh->materials) material_files(m);
+    const fs::path obj = o.mesh->name;
+    std::error_code ec;
+    if (o.mesh->name != "triangle" && fs::is_regular_file(obj, ec)) {
+      files.insert(obj);
+      for (const auto& mtl : mtllibs(obj)) files.insert(mtl);
+    }
+  }
+  std::map<std::string, std::string> out;
+  for (const auto& f : files) out[relative_to(f, root)] = fnv1a64_hex(read_bytes(f));
+  return out;
+}
+
+std::vector<fs::path> missing_cache_inputs(const fs::path& scene_file) {
+  std::vector<fs::path> out;
+  std::function<void(const json&)> walk = [&](const json& j) {
+    if (j.is_string()) {
+      if (auto p = expand_cache_prefix(j.get<std::string>()); p && !fs::exists(*p)) out.push_back(*p);
+    } else if (j.is_structured()) {
+      for (const auto& e : j) walk(e);
+    }
+  };
+  try {
+    walk(json::parse(read_bytes(scene_file)));
+  } catch (const json::exception&) {
+    // load_scene reports a malformed scene with its line.
+  }
+  return out;
+}
+
+std::string combined_hash(const std::map<std::string, std::string>& inputs) {
+  std::string all;
+  for (const auto& [f, h] : inputs) all += f + '\0' + h + '\n';
+  return "fnv1a64:" + fnv1a64_hex(all);
+}
+
+GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
+  const fs::path m = root_ / "golden" / "manifest.json";
+  if (!fs::exists(m)) return;
+  try {
+    const json j = json::parse(read_bytes(m));
+    for (const auto& e : j.at("goldens")) {
+      GoldenEntry g = entry_from(e);
+      entries_[g.name] = g;
+    }
+  } catch (const json::exception& e) {
+    throw InputError(m.string() + ": " + e.what());
+  }
+}
+
+std::vector<std::string> GoldenSet::all_names() const {
+  std::set<std::string> names;
+  if (fs::is_directory(root_ / "scenes"))
+    for (const auto& e : fs::directory_iterator(root_ / "scenes"))
+      if (e.path().extension() == ".json") names.insert(e.path().stem().string());
+  for (const auto& [n, e] : entries_) names.insert(n);
+  return {names.begin(), names.end()};
+}
+
+namespace {
+
+Image render_golden(const fs::path& scene_file, int w, int h, const json& settings, Scene* loaded = nullptr) {
+  Scene s = load_scene(scene_file);
+  s.width = w;
+  s.height = h;
+  const Image img = render(s, options_from(settings));
+  if (loaded) *loaded = std::move(s);
+  return img;
+}
+
+}  // namespace
+
+GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff_dir) const {
+  const fs::path scene_file = root_ / "scenes" / (name + ".json");
+  auto it = entries_.find(name);
+  if (it == entries_.end())
+    return {false, name + ": no golden image for scenes/" + name + ".json; render and record one with "
+                   "`rayaudit golden bless " + name + "` (then commit golden/)"};
+  const GoldenEntry& g = it->second;
+  if (!fs::exists(scene_file))
+    return {false, name + ": the scene " + g.scene + " is gone but its golden remains; `rayaudit golden bless " + name +
+                   "` removes it"};
+  Scene scene;
+  const Image ours = render_golden(scene_file, g.width, g.height, g.settings, &scene);
+  const auto inputs = scene_inputs(scene, root_);
+  const std::string hash = combined_hash(inputs);
+  const std::string changed = hash == g.inputs_hash ? "" : changed_inputs(g.inputs, inputs);
+  const Image golden = read_image(root_ / g.image);
+  if (golden.width != g.width || golden.height != g.height)
+    return {false, name + ": " + g.image + " is " + std::to_string(golden.width) + "x" +
+                   std::to_string(golden.height) + " but the manifest says " + std::to_string(g.width) + "x" +
+                   std::to_string(g.height) + "; re-bless it"};
+  const ImageComparison c = compare_images(ours, golden, g.bits);
+  const std::string size = std::to_string(g.width) + "x" + std::to_string(g.height);
+  if (c.identical() && changed.empty()) return {true, name + ": identical to " + g.image + " (" + size + ")"};
+  std::string msg;
+  if (c.identical()) {
+    msg = name + ": the image is identical to " + g.image + ", but the inputs changed since it was blessed (" +
+          changed + "): the golden is stale; record them with `rayaudit golden bless " + name + "`";
+    return {false, msg};
+  }
+  std::error_code ec;
+  fs::create_directories(diff_dir, ec);
+  const fs::path diff = diff_dir / (name + ".diff.png"), mine = diff_dir / (name + ".png");
+  write_image(diff, difference_image(ours, golden, g.bits));
+  write_image(mine, ours);
+  msg = name + ": differs from " + g.image + " (" + size + ")\n" + summary(c);
+  msg += "diff image: " + diff.string() + "\nthis render: " + mine.string() + "\n";
+  if (!changed.empty())
+    msg += "the inputs changed since the golden was blessed (" + changed +
+           "); if the new image is intended, `rayaudit golden bless " + name + "`";
+  else
+    msg += "the inputs are unchanged since the golden was blessed: the renderer's output changed";
+  return {false, msg};
+}
+
+std::string GoldenSet::bless(const std::string& name) {
+  const fs::path scene_file = root_ / "scenes" / (name + ".json");
+  if (!fs::exists(scene_file)) {
+    auto it = entries_.find(name);
+    if (it == entries_.end()) throw InputError(scene_file.string() + ": no such scene");
+    std::error_code ec;
+    fs::remove(root_ / it->second.image, ec);
+    entries_.erase(it);
+    removed_ = true;
+    return name + ": removed (its scene is gone)";
+  }
+  GoldenEntry g;
+  g.name = name;
+  g.scene = "scenes/" + name + ".json";
+  g.image = "golden/" + name + ".png";
+  g.settings = default_settings();
+  Scene scene = load_scene(scene_file);
+  golden_size(scene.width, scene.height, g.width, g.height);
+  const Image img = render_golden(scene_file, g.width, g.height, g.settings, &scene);
+  g.inputs = scene_inputs(scene, root_);
+  g.inputs_hash = combined_hash(g.inputs);
+
+  std::string what;
+  auto old = entries_.find(name);
+  const bool had_image = old != entries_.end() && fs::exists(root_ / old->second.image);
+  bool write_png = true;
+  if (!had_image) {
+    what = name + ": new golden " + g.image + " (" + std::to_string(g.width) + "x" + std::to_string(g.height) + ")";
+  } else {
+    const Image prev = read_image(root_ / old->second.image);
+    if (prev.width == g.width && prev.height == g.height) {
+      const ImageComparison c = compare_images(img, prev, g.bits);
+      if (c.identical()) {
+        write_png = false;
+        what = name + ": image unchanged";
+      } else {
+        what = name + ": image changed: " + std::to_string(c.differences.size()) + " of " +
+               std::to_string(c.pixels) + " pixels differ, max " + std::to_string(long(std::lround(c.max_error * 255))) +
+               "/255";
+      }
+    } else {
+      what = name + ": size changed to " + std::to_string(g.width) + "x" + std::to_string(g.height);
+    }
+    if (old->second.settings != g.settings)
+      what += "; render settings changed from " + old->second.settings.dump() + " to " + g.settings.dump();
+    if (old->second.inputs_hash != g.inputs_hash)
+      what += "; inputs changed: " + changed_inputs(old->second.inputs, g.inputs);
+    else
+      what += "; inputs unchanged";
+  }
+  std::error_code ec;
+  fs::create_directories(root_ / "golden", ec);
+  if (write_png) write_image(root_ / g.image, img, {8, false});
+  entries_[name] = g;
+  return what;
+}
+
+void GoldenSet::save() const {
+  json all = json::array();
+  for (const auto& [n, e] : entries_) all.push_back(to_json(e));
+  json j = {{"about", "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
+                      "`rayaudit golden check` (ctest label golden), rewritten only by `rayaudit golden bless`."},
+            {"goldens", all}};
+  std::error_code ec;
+  fs::create_directories(root_ / "golden", ec);
+  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2) + "\n");
+}
+
+}  // namespace ra

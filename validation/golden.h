@@ -1,0 +1,72 @@
+// Golden images: our own renders of every scene in scenes/, small, stored
+// in golden/ as 8-bit PNGs with golden/manifest.json naming, for each, the
+// scene, the size and render settings, and a hash of every input file (the
+// scene, its meshes and their MTL files, textures). A check renders the
+// scene again and compares with OpenImageIO: any pixel that differs fails,
+// and a diff image is written. Only `bless` rewrites a golden, and only when
+// asked; CI never blesses.
+#pragma once
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "image_compare.h"
+#include "scene.h"
+
+namespace ra {
+
+// The largest golden dimension: scenes are rendered at most this wide or
+// tall (keeping the aspect ratio as well as whole pixels allow).
+inline constexpr int kGoldenMaxSize = 160;
+
+struct GoldenEntry {
+  std::string name;   // the scene's stem: scenes/NAME.json
+  std::string scene;  // relative to the root: "scenes/NAME.json"
+  std::string image;  // relative to the root: "golden/NAME.png"
+  int width = 0, height = 0, bits = 8;
+  nlohmann::json settings;                    // render options
+  std::string inputs_hash;                    // over all inputs below
+  std::map<std::string, std::string> inputs;  // relative path -> content hash
+};
+
+// Hashes (FNV-1a 64, hex) of a scene's input files, keyed by path relative to
+// `root` (absolute when outside it): the scene file, each mesh's OBJ and its
+// mtllib files, every texture and bump image.
+std::map<std::string, std::string> scene_inputs(const Scene& scene, const std::filesystem::path& root);
+std::string combined_hash(const std::map<std::string, std::string>& inputs);
+
+// The "${cache}/..." files a scene file names that do not exist (the teapot
+// ci/main.sh generates, the corpus ci/fetch-corpus.sh fetches): a test of
+// such a scene is skipped, saying so, rather than failed.
+std::vector<std::filesystem::path> missing_cache_inputs(const std::filesystem::path& scene_file);
+
+class GoldenSet {
+ public:
+  // Reads root/golden/manifest.json (an empty set when there is none).
+  explicit GoldenSet(std::filesystem::path root);
+
+  // Scene names: scenes/*.json stems, and any entries whose scene is gone.
+  std::vector<std::string> all_names() const;
+
+  struct Result {
+    bool pass = false;
+    std::string message;  // what was found, with the diff image's path on failure
+  };
+  // Renders `name` and compares with its golden; on failure writes
+  // diff_dir/NAME.diff.png (false colour) and diff_dir/NAME.png (ours).
+  Result check(const std::string& name, const std::filesystem::path& diff_dir) const;
+
+  // Renders `name` and records it; returns a line saying what changed.
+  // save() writes the manifest.
+  std::string bless(const std::string& name);
+  void save() const;
+
+ private:
+  std::filesystem::path root_;
+  std::map<std::string, GoldenEntry> entries_;
+  bool removed_ = false;
+};
+
+}  // namespace ra

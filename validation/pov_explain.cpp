@@ -1,0 +1,130 @@
+#include "pov_explain.h"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "camera.h"
+#include "spawn.h"
+
+namespace ra {
+namespace {
+
+// The scene as POV-Ray's mesh2 holds it: with `float32`, every mesh's
+// vertices, normals and UVs rounded to float32; with `flatten`, each smooth
+// triangle whose three normals are equal made flat (given the normal of its
+// vertices), as POV-Ray does.
+Scene as_pov_stores_it(const Scene& scene, bool float32, bool flatten) {
+  Scene s = scene;
+  for (auto& o : s.objects) {
+    if (o.kind != Object::Kind::mesh) continue;
+    auto set = std::make_shared<TriangleSet>(*o.mesh);
+    if (float32) {
+      for (auto& p : set->positions) p = Vec3d(Vec3f(p));
+      for (auto& n : set->normals) {
+        const double len = length(n);
+        if (len > 0) n = Vec3d(Vec3f(n / len));
+      }
+      for (auto& uv : set->uvs) uv = {double(float(uv[0])), double(float(uv[1]))};
+    }
+    if (flatten && set->shading == Shading::smooth) {
+      for (auto& tri : set->triangles) {
+        if (tri.n[0] < 0 || tri.n[1] < 0 || tri.n[2] < 0) continue;
+        const Vec3d &na = set->normals[tri.n[0]], &nb = set->normals[tri.n[1]], &nc = set->normals[tri.n[2]];
+        if (!(na == nb && nb == nc)) continue;
+        const Vec3d &a = set->positions[tri.v[0]], &b = set->positions[tri.v[1]], &c = set->positions[tri.v[2]];
+        Vec3d g = normalize(cross(b - a, c - a));
+        if (dot(g, na) < 0) g = -g;
+        set->normals.push_back(g);
+        const int gi = int(set->normals.size()) - 1;
+        tri.n = {gi, gi, gi};
+      }
+    }
+    o.mesh = set;
+  }
+  return s;
+}
+
+double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+}  // namespace
+
+std::vector<PixelExplanation> explain_differences(const Scene& scene, const Image& ours, const Image& pov,
+                                                  const ImageComparison& c, const RenderOptions& options) {
+  std::vector<PixelExplanation> out;
+  if (c.differences.empty()) return out;
+  RenderOptions quiet = options;
+  quiet.progress = false;
+  struct Model {
+    const char* cause;
+    Scene scene;
+  };
+  const Model models[] = {
+      {"float32: with the mesh's vertices, normals and UVs rounded to float32, as POV-Ray's mesh2 stores them, "
+       "our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, false)},
+      {"equal normals: POV-Ray makes a triangle whose three normals are equal flat, with the normal of its "
+       "vertices rather than the given one; done so (and with float32 mesh data), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true)},
+  };
+  std::vector<std::unique_ptr<Tracer>> model_tracers;
+  for (const auto& m : models) model_tracers.push_back(std::make_unique<Tracer>(m.scene, quiet));
+  const Tracer tracer(scene, quiet);
+  const Camera camera(scene.camera, scene.width, scene.height);
+  const unsigned m = c.bits == 16 ? 65535u : 255u;
+  for (const auto& d : c.differences) {
+    PixelExplanation e{d.x, d.y, d.levels, ""};
+    for (std::size_t mi = 0; mi < model_tracers.size() && e.cause.empty(); ++mi) {
+      const Color rc = model_tracers[mi]->pixel(d.x, d.y);
+      const float rf[3] = {float(rc.x), float(rc.y), float(rc.z)};
+      bool same = true;
+      for (int ch = 0; ch < 3; ++ch) same &= quantize(rf[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
+      if (same) e.cause = models[mi].cause;
+    }
+    if (e.cause.empty()) {
+      // Our value within a few float32 ulps of a rounding boundary (k + 0.5) / max.
+      for (int ch = 0; ch < 3 && e.cause.empty(); ++ch) {
+        const float v = ours.at(d.x, d.y)[ch];
+        const double scaled = double(v) * m;
+        const double boundary = std::floor(scaled) + 0.5;
+        const double ulp = double(std::nextafter(v, 2.f) - v) * m;
+        if (std::abs(scaled - boundary) <= 4 * ulp || std::abs(scaled - (boundary - 1)) <= 4 * ulp) {
+          char buf[300];
+          std::snprintf(buf, sizeof buf,
+                        "float32 colour: our channel %d is %.9g levels, within 4 float32 ulps of a rounding boundary "
+                        "(k + 0.5); POV-Ray computes colours in float32, so its value falls on the other side",
+                        ch, scaled);
+          e.cause = buf;
+        }
+      }
+    }
+    if (!e.cause.empty()) {
+      out.push_back(e);
+      continue;
+    }
+    // POV's shadow cache
+    Ray<double> r = camera.ray(d.x + 0.5, d.y + 0.5);
+    r.tmin = kPovMinIsectDepth;
+    if (const auto hit = tracer.intersect(r); hit && luminance(pov.at(d.x, d.y)) < luminance(ours.at(d.x, d.y))) {
+      const Vec3d p = r.at(hit->t);
+      for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+        const Vec3d lv = scene.lights[li].position - p;
+        const Ray<double> probe{p, normalize(lv), kPovMinIsectDepth, kPovShadowTolerance};
+        if (const auto b = tracer.intersect(probe)) {
+          char buf[400];
+          std::snprintf(buf, sizeof buf,
+                        "shadow cache: the shadow ray to light %zu meets object %d (triangle %d) at t = %.3g, inside "
+                        "[1e-4, 1e-3], where POV-Ray's re-test of the previous shadow ray's blocker accepts it and "
+                        "our (and POV's ordinary) window (1e-3, dist - 1e-3) does not: POV's pixel is darker",
+                        li, b->object, b->prim, b->t);
+          e.cause = buf;
+          break;
+        }
+      }
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace ra

@@ -1,0 +1,130 @@
+#include "pov_runner.h"
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "atomic_file.h"
+#include "errors.h"
+#include "pov_export.h"
+
+namespace ra {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Removes the working directory unless asked to keep it.
+struct WorkDir {
+  fs::path path;
+  bool keep = false;
+  ~WorkDir() {
+    std::error_code ec;
+    if (!keep && !path.empty()) fs::remove_all(path, ec);
+  }
+};
+
+// Runs argv in `dir` with stdout and stderr to files there; returns the
+// exit status (or -1 when it did not exit normally).
+int run_in(const fs::path& dir, const std::vector<std::string>& argv, const fs::path& out, const fs::path& err) {
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    const int in = open("/dev/null", O_RDONLY);
+    if (o < 0 || e < 0 || in < 0 || chdir(dir.c_str()) != 0) _exit(126);
+    dup2(in, 0);
+    dup2(o, 1);
+    dup2(e, 2);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+fs::path find_povray() {
+  if (const char* env = std::getenv("RAYAUDIT_POVRAY"); env && *env) {
+    if (access(env, X_OK) != 0)
+      throw InputError(std::string("RAYAUDIT_POVRAY=") + env + " is not an executable program");
+    return env;
+  }
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path ? path : "/usr/bin:/bin");
+  for (std::string d; std::getline(dirs, d, ':');) {
+    if (d.empty()) continue;
+    const fs::path p = fs::path(d) / "povray";
+    if (access(p.c_str(), X_OK) == 0) return p;
+  }
+  throw InputError(
+      "POV-Ray is not installed (no `povray` on the PATH): install the Debian package 'povray' "
+      "(ci/install-deps.sh does), or set RAYAUDIT_POVRAY to the program");
+}
+
+std::string pov_ini(int bits) {
+  return "; rayaudit's own settings: one ray per pixel, linear output, fixed render order.\n"
+         "Antialias=Off\nDisplay=Off\nPause_When_Done=Off\nVerbose=Off\nOutput_File_Type=N\n"
+         "Bits_Per_Color=" +
+         std::to_string(bits) +
+         "\nFile_Gamma=1.0\nQuality=9\nWork_Threads=1\nOutput_Alpha=Off\nOutput_To_File=On\n";
+}
+
+PovRun render_with_povray(const Scene& scene, const PovRunOptions& options) {
+  find_povray();  // say that POV-Ray is missing before anything else
+  return run_povray(export_pov(scene), scene.width, scene.height, options);
+}
+
+PovRun run_povray(const PovExport& ex, int width, int height, const PovRunOptions& options) {
+  if (options.bits != 8 && options.bits != 16) throw InputError("POV-Ray bits per colour must be 8 or 16");
+  const fs::path povray = find_povray();
+
+  // A private directory: mkdtemp creates it mode 0700 under a fresh name.
+  std::string tmpl = "/tmp/rayaudit-pov-XXXXXX";
+  if (!mkdtemp(tmpl.data())) throw InputError("cannot create a working directory under /tmp");
+  WorkDir work{tmpl, options.keep_dir};
+  write_text_atomically(work.path / "scene.pov", ex.sdl);
+  write_text_atomically(work.path / "rayaudit.ini", pov_ini(options.bits));
+  for (const auto& img : ex.images) copy_pov_image(img.source, work.path / img.name);
+
+  const std::vector<std::string> argv = {povray.string(),
+                                         "rayaudit.ini",
+                                         "+Iscene.pov",
+                                         "+Oout.png",
+                                         "+W" + std::to_string(width),
+                                         "+H" + std::to_string(height),
+                                         "+WT1"};
+  const int code = run_in(work.path, argv, work.path / "povray.out", work.path / "povray.err");
+  PovRun run;
+  run.log = read_text(work.path / "povray.err");
+  if (code != 0 || !fs::exists(work.path / "out.png")) {
+    work.keep = options.keep_on_failure;
+    throw CheckFailed("POV-Ray failed (" + (code < 0 ? std::string("killed") : "exit " + std::to_string(code)) +
+                      ") on the exported scene" +
+                      (work.keep ? "; its files are kept in " + work.path.string() : std::string()) +
+                      "\n--- POV-Ray's stderr ---\n" + run.log);
+  }
+  run.image = read_image(work.path / "out.png");
+  if (options.keep_dir) run.dir = work.path;
+  return run;
+}
+
+}  // namespace ra

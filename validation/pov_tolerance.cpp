@@ -1,0 +1,73 @@
+#include "pov_tolerance.h"
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "errors.h"
+
+namespace ra {
+
+std::filesystem::path pov_tolerance_path(const std::filesystem::path& scene_file) {
+  return scene_file.parent_path() / "pov" / (scene_file.stem().string() + ".json");
+}
+
+PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
+  PovTolerance t;
+  if (!std::filesystem::exists(file)) return t;
+  t.file = file;
+  std::ifstream in(file);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (it.key() != "notes" && it.key() != "width" && it.key() != "height" && it.key() != "pixels" &&
+          it.key() != "max_levels_16")
+        throw InputError(file.string() + ": /" + it.key() + ": unknown key");
+    t.notes = j.value("notes", "");
+    if (j.contains("width")) t.width = j.at("width").get<int>();
+    if (j.contains("height")) t.height = j.at("height").get<int>();
+    t.max_levels_16 = j.value("max_levels_16", t.max_levels_16);
+    for (const auto& p : j.value("pixels", nlohmann::json::array())) {
+      ExplainedPixel e{p.at("x").get<int>(), p.at("y").get<int>(), p.at("cause").get<std::string>()};
+      if (e.cause.empty()) throw InputError(file.string() + ": every listed pixel needs its cause");
+      t.pixels.push_back(e);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(file.string() + ": " + e.what());
+  }
+  return t;
+}
+
+PovVerdict judge(const ImageComparison& c, const PovTolerance& t) {
+  PovVerdict v;
+  const std::string where = t.file.empty() ? "(no tolerance file: identical at 8 bits required)" : t.file.string();
+  const bool list_applies = (!t.width || *t.width == c.width) && (!t.height || *t.height == c.height);
+  std::map<std::pair<int, int>, const ExplainedPixel*> listed;
+  if (list_applies)
+    for (const auto& p : t.pixels) listed[{p.x, p.y}] = &p;
+  else if (!t.pixels.empty())
+    v.lines.push_back("note: the explained pixels in " + where + " are for " + std::to_string(t.width.value_or(0)) +
+                      "x" + std::to_string(t.height.value_or(0)) + ", not this size: none apply");
+  std::map<std::pair<int, int>, int> seen;
+  for (const auto& d : c.differences) {
+    seen[{d.x, d.y}] = d.levels;
+    const std::string at = "pixel (" + std::to_string(d.x) + ", " + std::to_string(d.y) + ") differs by " +
+                           std::to_string(d.levels) + (d.levels == 1 ? " level" : " levels");
+    if (auto it = listed.find({d.x, d.y}); it != listed.end()) {
+      v.lines.push_back(at + ": explained: " + it->second->cause);
+    } else if (c.bits == 16 && d.levels <= t.max_levels_16) {
+      continue;  // POV's float32 colours; counted in the summary, not listed
+    } else {
+      v.pass = false;
+      v.lines.push_back(at + ": NOT explained in " + where);
+    }
+  }
+  for (const auto& [xy, p] : listed)
+    if (!seen.count(xy))
+      v.lines.push_back("pixel (" + std::to_string(xy.first) + ", " + std::to_string(xy.second) +
+                        ") is listed in " + where + " but no longer differs: remove it");
+  return v;
+}
+
+}  // namespace ra
