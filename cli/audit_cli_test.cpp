@@ -2,6 +2,8 @@
 // codes, the --cases JSON shape, malformed input, export round trip, determinism.
 #include <gtest/gtest.h>
 
+#include "run_rayaudit.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -37,10 +39,8 @@ std::string slurp(const fs::path& p) {
 }
 
 Result rayaudit(const std::string& args) {
-  const fs::path out = tmp("stdout.txt"), err = tmp("stderr.txt");
-  const std::string cmd = std::string(RAYAUDIT_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(cmd.c_str());
-  return {WEXITSTATUS(status), slurp(out), slurp(err)};
+  const auto r = ra::test::run_rayaudit(args);
+  return {r.code, r.out, r.err};
 }
 
 void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }

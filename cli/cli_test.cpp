@@ -2,6 +2,8 @@
 // and no output file on failure.
 #include <gtest/gtest.h>
 
+#include "run_rayaudit.h"
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -16,18 +18,12 @@ namespace {
 
 struct Result {
   int code;
-  std::string out;
+  std::string out;  // stdout and stderr
 };
 
 Result run(const std::string& args) {
-  const std::string cmd = std::string(RAYAUDIT_EXE) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  const int status = pclose(p);
-  return {WEXITSTATUS(status), out};
+  const auto r = ra::test::run_rayaudit(args);
+  return {r.code, r.all};
 }
 
 fs::path temp_dir() {

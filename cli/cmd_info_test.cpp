@@ -1,6 +1,8 @@
 // `rayaudit info` and `rayaudit convert` run as a user would.
 #include <gtest/gtest.h>
 
+#include "run_rayaudit.h"
+
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -10,16 +12,11 @@ namespace {
 
 struct Result {
   int code;
-  std::string out;
+  std::string out;  // stdout and stderr
 };
 Result run(const std::string& args) {
-  Result r{0, ""};
-  FILE* p = popen((std::string(RAYAUDIT_EXE) + " " + args + " 2>&1").c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  r.code = WEXITSTATUS(pclose(p));
-  return r;
+  const auto r = ra::test::run_rayaudit(args);
+  return {r.code, r.all};
 }
 
 TEST(CliInfo, JsonFields) {

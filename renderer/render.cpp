@@ -141,8 +141,6 @@ struct Tracer::Impl {
     m.stride = k.pre_bytes;
     m.pre.resize(m.stride * set.triangles.size());
     m.gnormal.resize(set.triangles.size());
-    const bool need_vertex_normals = set.shading == Shading::smooth;
-    if (need_vertex_normals) m.vertex_normal.assign(set.positions.size(), Vec3d{0, 0, 0});
     for (std::size_t i = 0; i < set.triangles.size(); ++i) {
       const auto& tri = set.triangles[i];
       const Vec3d& a = set.positions[tri.v[0]];
@@ -152,13 +150,8 @@ struct Tracer::Impl {
       const Vec3d n = cross(b - a, c - a);  // length = twice the area
       const double len = length(n);
       m.gnormal[i] = len > 0 ? n / len : Vec3d{0, 0, 0};
-      if (need_vertex_normals)
-        for (int v : tri.v) m.vertex_normal[v] += n;  // area-weighted
     }
-    for (auto& n : m.vertex_normal) {
-      const double len = length(n);
-      if (len > 0) n = n / len;
-    }
+    if (set.shading == Shading::smooth) m.vertex_normal = area_weighted_vertex_normals(set);
     Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
     for (const auto& p : set.positions) {
       lo = vmin(lo, p);

@@ -333,6 +333,20 @@ Scene load_scene(const std::filesystem::path& file) {
   return parse_scene_json(ss.str(), file);
 }
 
+std::vector<Vec3d> area_weighted_vertex_normals(const TriangleSet& set) {
+  std::vector<Vec3d> vn(set.positions.size(), Vec3d{0, 0, 0});
+  for (const auto& tri : set.triangles) {
+    const Vec3d& a = set.positions[tri.v[0]];
+    const Vec3d n = cross(set.positions[tri.v[1]] - a, set.positions[tri.v[2]] - a);
+    for (int v : tri.v) vn[v] += n;
+  }
+  for (auto& n : vn) {
+    const double len = length(n);
+    if (len > 0) n = n / len;
+  }
+  return vn;
+}
+
 BoundingSphere scene_bounds(const Scene& scene) {
   Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   bool any = false;

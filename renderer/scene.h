@@ -89,6 +89,11 @@ struct TriangleSet {
   Shading shading = Shading::flat;
 };
 
+// Unit vertex normals for smooth shading of a set without `vn`: each vertex
+// gets the sum of its triangles' (B-A)x(C-A), i.e. normals weighted by area,
+// normalised. The renderer and the POV-Ray exporter both use this.
+std::vector<Vec3d> area_weighted_vertex_normals(const TriangleSet& set);
+
 struct Object {
   enum class Kind { sphere, plane, mesh } kind = Kind::sphere;
   SphereObject sphere;

@@ -86,22 +86,6 @@ std::string texture(const Material& m, bool with_uv, ImageNames& names) {
   return "texture { " + pigment + normal + " " + finish(m) + " }";
 }
 
-// The area-weighted vertex normals our tracer uses for smooth triangles
-// without normal indices (renderer/render.cpp, PreparedMesh).
-std::vector<Vec3d> vertex_normals(const TriangleSet& set) {
-  std::vector<Vec3d> vn(set.positions.size(), Vec3d{0, 0, 0});
-  for (const auto& tri : set.triangles) {
-    const Vec3d& a = set.positions[tri.v[0]];
-    const Vec3d n = cross(set.positions[tri.v[1]] - a, set.positions[tri.v[2]] - a);
-    for (int v : tri.v) vn[v] += n;
-  }
-  for (auto& n : vn) {
-    const double len = length(n);
-    if (len > 0) n = n / len;
-  }
-  return vn;
-}
-
 bool has(const std::array<int, 3>& idx) { return idx[0] >= 0 && idx[1] >= 0 && idx[2] >= 0; }
 
 std::string idx3(int a, int b, int c) {
@@ -125,7 +109,7 @@ void write_mesh2(std::ostringstream& out, const TriangleSet& set, ImageNames& na
   if (smooth) {
     std::vector<Vec3d> normals = set.normals;
     if (need_computed) {
-      const auto vn = vertex_normals(set);
+      const auto vn = area_weighted_vertex_normals(set);
       normals.insert(normals.end(), vn.begin(), vn.end());
     }
     out << "  normal_vectors { " << normals.size();
