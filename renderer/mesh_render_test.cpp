@@ -376,14 +376,19 @@ TEST(Accel, CullingChangesNothingOnClosedMeshesSeenFromOutside) {
       o.cull = true;
       const Tracer culled(scene, o);
       const Camera cam(scene.camera, scene.width, scene.height);
-      for (int j = 0; j < scene.height; ++j)
+      for (int j = 0; j < scene.height; ++j) {
         for (int i = 0; i < scene.width; ++i) {
           const auto r = cam.ray(i + 0.5, j + 0.5);
           const auto h1 = plain.intersect(r), h2 = culled.intersect(r);
           ASSERT_EQ(h1.has_value(), h2.has_value()) << i << "," << j;
-          if (h1) EXPECT_TRUE(h1->t == h2->t && h1->object == h2->object && h1->prim == h2->prim);
+          if (h1) {
+            EXPECT_TRUE(h1->t == h2->t && h1->object == h2->object && h1->prim == h2->prim);
+          }
         }
-      if (std::string(shading) == "flat") EXPECT_EQ(plain.render().rgb, culled.render().rgb) << accel_name(a);
+      }
+      if (std::string(shading) == "flat") {
+        EXPECT_EQ(plain.render().rgb, culled.render().rgb) << accel_name(a);
+      }
     }
   }
 }

@@ -81,13 +81,36 @@ std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<
   if (!(t >= r.tmin && t <= r.tmax)) return std::nullopt;
 
   // pbrt-v4's bound on t's rounding error: t must exceed it to be surely > 0.
+  // Each sheared x' = x_t + Sx z_t (x_t, z_t: translated, not yet scaled) is
+  // within gamma(5) (|x_t| + |Sx z_t|) of its exact value. pbrt-v4 writes that
+  // bound as gamma(5) (max|x'| + max|z'|) with the *scaled* z' = z_t / d_z,
+  // which mixes units: it is safe only while |d| is about 1. For |d| = s the
+  // z' term is 1/s times too large: with s = 1e-8 (the audit's scale@1e-08
+  // family aims d = target - origin, so |d| ~ 1e-8) it made delta_e exceed the
+  // edge functions themselves and delta_t reach 2..200 for hits at t ~ 1
+  // (907 of 1386 true hits rejected in float); for |d| >> 1 it was too small.
+  // The terms below keep each quantity in its own units, so the test's
+  // verdict no longer depends on |d| (see WatertightTBound tests).
+  // Conservative by design (kept): at a grazing angle th the sheared triangle
+  // is a sliver of width ~th, its edge functions carry errors ~gamma |x_t|/th
+  // relative, and delta_t ~ C gamma(5) / th, C ~ 3..50 for the audit's unit
+  // triangles at t ~ 1 (|d| in [1, 10] adds up to 10x more). In float
+  // (gamma(5) = 3e-7) hits start being dropped near th ~ 1e-5 (grazing@1e-05:
+  // 467 of 1416, 20000 rays) and nearly all below (grazing@1e-06: 1329 of
+  // 1342; moller keeps most because it certifies nothing); in double the
+  // threshold is ~1e-14. The sign of t could be certified exactly instead
+  // (all z' > 0 puts the triangle in front of the origin), but that is not
+  // pbrt's or the paper's test.
+  const T max_xt = std::max(std::abs(A[kx]), std::max(std::abs(B[kx]), std::abs(C[kx])));
+  const T max_yt = std::max(std::abs(A[ky]), std::max(std::abs(B[ky]), std::abs(C[ky])));
+  const T max_zt = std::max(std::abs(A[kz]), std::max(std::abs(B[kz]), std::abs(C[kz])));
   const T max_z = std::max(std::abs(az), std::max(std::abs(bz), std::abs(cz)));
   const T max_x = std::max(std::abs(ax), std::max(std::abs(bx), std::abs(cx)));
   const T max_y = std::max(std::abs(ay), std::max(std::abs(by), std::abs(cy)));
   const T max_e = std::max(std::abs(e0), std::max(std::abs(e1), std::abs(e2)));
   const T delta_z = gamma<T>(3) * max_z;
-  const T delta_x = gamma<T>(5) * (max_x + max_z);
-  const T delta_y = gamma<T>(5) * (max_y + max_z);
+  const T delta_x = gamma<T>(5) * (max_xt + std::abs(Sx) * max_zt);
+  const T delta_y = gamma<T>(5) * (max_yt + std::abs(Sy) * max_zt);
   const T delta_e = T(2) * (gamma<T>(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
   const T delta_t =
       T(3) * (gamma<T>(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * std::abs(inv_det);
