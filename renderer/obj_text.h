@@ -94,10 +94,12 @@ inline bool starts_with_ci(const char* p, const char* end, const char* word) {
   return true;
 }
 
-// Clinger's fast path: [sign] digits [. digits] with at most 19 digits, a
-// mantissa <= 2^53 and at most 22 decimals is mantissa / 10^k, one correctly
-// rounded division of exact values, so the same double from_chars gives.
-// Returns false (p unchanged) for anything else (exponents, long numbers).
+// Clinger's fast path: [sign] digits [. digits] [e [sign] digits] with at
+// most 19 significant-or-not digits, a mantissa <= 2^53 and a power of ten
+// |e| <= 22 is mantissa x 10^e or mantissa / 10^-e, one correctly rounded
+// operation on exact values, so the same double from_chars gives. Returns
+// false (p unchanged) for anything else (long numbers, large exponents, a
+// malformed exponent): the caller then uses from_chars.
 inline bool fast_double(const char*& p, const char* end, double& out) {
   static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                       1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
@@ -111,9 +113,23 @@ inline bool fast_double(const char*& p, const char* end, double& out) {
     ++s;
     while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits, ++frac;
   }
-  if (digits == 0 || digits > 19 || mant > (1ull << 53) || frac > 22) return false;
-  if (s < end && (*s == 'e' || *s == 'E')) return false;
-  const double v = frac ? double(mant) / kPow10[frac] : double(mant);
+  if (digits == 0 || digits > 19 || mant > (1ull << 53)) return false;
+  int e10 = -frac;
+  if (s < end && (*s == 'e' || *s == 'E')) {
+    ++s;
+    bool eneg = false;
+    if (s < end && (*s == '-' || *s == '+')) eneg = *s++ == '-';
+    const char* d = s;
+    int e = 0;
+    while (s < end && unsigned(*s - '0') < 10 && s - d < 4) e = e * 10 + (*s++ - '0');
+    if (s == d || (s < end && unsigned(*s - '0') < 10)) return false;  // no digits, or more than 4
+    e10 += eneg ? -e : e;
+  }
+  double v;
+  if (mant == 0) v = 0;
+  else if (e10 < 0 && e10 >= -22) v = double(mant) / kPow10[-e10];
+  else if (e10 >= 0 && e10 <= 22) v = double(mant) * kPow10[e10];
+  else return false;
   out = neg ? -v : v;
   p = s;
   return true;
