@@ -20,6 +20,7 @@
 // error in parallel mode re-runs the serial parse, so the message is the one
 // of the first error in the file, as in serial mode.
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -199,6 +200,22 @@ Hint quick_count(const char* s, size_t n) {
     h.v += cv, h.vt += cvt, h.vn += cvn, h.f += cf;
   }
   return h;
+}
+
+// Asks for transparent huge pages on a large, not yet touched buffer: a
+// fresh 70 MB triangle array otherwise costs ~17k page faults (4 KiB each),
+// which was a third of the parse time. Advice only; errors are ignored.
+template <class T>
+void advise_huge(const std::vector<T>& v) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  const size_t bytes = v.capacity() * sizeof(T);
+  if (bytes < (size_t(4) << 20)) return;
+  const uintptr_t page = 4096, b = (uintptr_t(v.data()) + page - 1) & ~(page - 1),
+                  e = (uintptr_t(v.data()) + bytes) & ~(page - 1);
+  if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
+#else
+  (void)v;
+#endif
 }
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
@@ -462,13 +479,26 @@ struct ChunkParser {
     t.object = c.cur_object;
     t.smoothing = c.cur_smooth;
     if (serial) {
-      t.gnormal = face_normal(m.positions, t.v);
       if (m.triangles.size() == m.triangles.capacity()) grow_triangles();
       m.triangles.push_back(t);
+      if (m.triangles.size() - normals_done >= kNormalBlock) finish_normals();
     } else {
       if (itri >= c.ntris) throw std::logic_error("obj_loader: count and parse passes disagree");
       m.triangles[size_t(c.base_tri + itri++)] = t;
     }
+  }
+
+  // Serial: gnormal of the triangles emitted since the last call, in blocks
+  // while they are still in cache; a tight loop over independent triangles
+  // overlaps the position loads and the sqrt/divisions far better than one
+  // triangle at a time between parsing statements.
+  static constexpr size_t kNormalBlock = 512;
+  size_t normals_done = 0;
+  void finish_normals() {
+    MeshTriangle* t = m.triangles.data();
+    const size_t n = m.triangles.size();
+    for (size_t i = normals_done; i < n; ++i) t[i].gnormal = face_normal(m.positions, t[i].v);
+    normals_done = n;
   }
 
   // Serial: the hint was short (polygons, or lines the hint missed): grow to
@@ -478,6 +508,7 @@ struct ChunkParser {
     const double done = double(here - c.begin + 1), total = double(c.end - c.begin);
     const size_t guess = size_t(double(v.size()) * (total / done) * 1.05) + 64;
     v.reserve(std::max(guess, v.size() + v.size() / 2 + 64));
+    advise_huge(v);
   }
   // o / usemtl: the rest of the line; empty means none (-1).
   int parse_name(NameTable& table, const char* p, const char* se, long line) {
@@ -775,7 +806,10 @@ Mesh parse_serial(std::string_view text, const std::string& name, const ObjOptio
   m.uvs.reserve(h.vt);
   m.normals.reserve(h.vn);
   m.triangles.reserve(h.f);
-  ChunkParser{c, m, Where{&name}, true}.run();
+  advise_huge(m.positions), advise_huge(m.uvs), advise_huge(m.normals), advise_huge(m.triangles);
+  ChunkParser cp{c, m, Where{&name}, true};
+  cp.run();
+  cp.finish_normals();
   merge(m, chunks, opt);
   return m;
 }
