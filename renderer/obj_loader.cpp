@@ -308,10 +308,12 @@ struct ChunkParser {
       if (k == 3) return nullptr;
       const bool neg = *p == '-';
       p += neg;
-      const char* d = p;
-      long i = 0;
-      while (p < end && unsigned(*p - '0') < 10 && p - d < 10) i = i * 10 + (*p++ - '0');
-      if (p == d || !value_end(p, end) || i == 0 || i > nv) return nullptr;
+      std::uint64_t u = 0;
+      int digits = 0;
+      read_digits(p, end, u, digits);
+      if (digits == 0 || digits > 10 || !value_end(p, end)) return nullptr;
+      const long i = long(u);
+      if (i == 0 || i > nv) return nullptr;
       idx[k++] = int(neg ? nv - i : i - 1);
     }
     if (k != 3) return nullptr;

@@ -3,7 +3,9 @@
 // read; nothing allocates). A "statement" is one logical line: physical lines
 // joined by a `\` right before their end (LF or CRLF).
 #pragma once
+#include <bit>
 #include <charconv>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -94,6 +96,48 @@ inline bool starts_with_ci(const char* p, const char* end, const char* word) {
   return true;
 }
 
+// Up to 8 ASCII digits at p, 8 bytes of which must be readable (SWAR: one
+// load, the run length from a carry-free per-byte compare, the value from
+// three multiplies, as in fast_float's parse_eight_digits_unrolled).
+// Returns how many digits (0..8) and their value.
+inline int eight_digits(const char* p, std::uint64_t& value) {
+  std::uint64_t x;
+  std::memcpy(&x, p, 8);
+  if constexpr (std::endian::native == std::endian::big) x = __builtin_bswap64(x);
+  const std::uint64_t t = x ^ 0x3030303030303030ull;  // digits become bytes 0..9
+  // A byte > 9 gets its top bit from t + 0x76 (no carry out of a byte <= 9,
+  // so the lowest flagged byte is exact) or, if >= 0x80, from t itself.
+  const std::uint64_t nd = ((t + 0x7676767676767676ull) | t) & 0x8080808080808080ull;
+  const int n = nd ? __builtin_ctzll(nd) >> 3 : 8;
+  if (n == 0) {
+    value = 0;
+    return 0;
+  }
+  std::uint64_t v = t << (8 * (8 - n));  // leading zeros in the low bytes
+  v = v * 10 + (v >> 8);
+  v = (((v & 0x000000FF000000FFull) * (100 + (1000000ull << 32))) +
+       (((v >> 16) & 0x000000FF000000FFull) * (1 + (10000ull << 32)))) >>
+      32;
+  value = v;
+  return n;
+}
+
+// Reads a run of decimal digits at s (advancing it): mant = mant * 10^k +
+// digits, digits += k. mant wraps silently past 19 digits: callers reject
+// those by the count.
+inline void read_digits(const char*& s, const char* end, std::uint64_t& mant, int& digits) {
+  static constexpr std::uint64_t kP10[] = {1, 10, 100, 1000, 10000, 100000, 1000000, 10000000, 100000000};
+  while (end - s >= 8) {
+    std::uint64_t v;
+    const int n = eight_digits(s, v);
+    mant = mant * kP10[n] + v;
+    digits += n;
+    s += n;
+    if (n < 8) return;
+  }
+  while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits;
+}
+
 // Clinger's fast path: [sign] digits [. digits] [e [sign] digits] with at
 // most 19 significant-or-not digits, a mantissa <= 2^53 and a power of ten
 // |e| <= 22 is mantissa x 10^e or mantissa / 10^-e, one correctly rounded
@@ -106,12 +150,14 @@ inline bool fast_double(const char*& p, const char* end, double& out) {
   const char* s = p;
   bool neg = false;
   if (s < end && (*s == '-' || *s == '+')) neg = *s++ == '-';
-  unsigned long long mant = 0;
+  std::uint64_t mant = 0;
   int digits = 0, frac = 0;
-  while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits;
+  read_digits(s, end, mant, digits);
   if (s < end && *s == '.') {
     ++s;
-    while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits, ++frac;
+    const int before = digits;
+    read_digits(s, end, mant, digits);
+    frac = digits - before;
   }
   if (digits == 0 || digits > 19 || mant > (1ull << 53)) return false;
   int e10 = -frac;
