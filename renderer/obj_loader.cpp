@@ -118,6 +118,7 @@ struct Chunk {
   // step 1 output
   NameTable mats, groups, objects;
   int cur_mat = kInherit, cur_group = kInherit, cur_object = kInherit, cur_smooth = kInherit;
+  std::vector<TriangleRun> runs;  // chunk-local: first counts from the chunk's first triangle
   long vp = 0, l = 0, p = 0;
   std::vector<std::pair<long, std::string>> mtllibs;
   std::vector<Unknown> unknown;
@@ -347,10 +348,10 @@ struct ChunkParser {
       case Kw::VP: ++c.vp; return;
       case Kw::L: ++c.l; return;
       case Kw::P: ++c.p; return;
-      case Kw::O: c.cur_object = parse_name(c.objects, kend, se, line); return;
+      case Kw::O: c.cur_object = parse_name(c.objects, kend, se, line), tags_changed = true; return;
       case Kw::Usemtl: c.cur_mat = parse_name(c.mats, kend, se, line); return;
-      case Kw::G: c.cur_group = parse_group(kend, se, line); return;
-      case Kw::S: c.cur_smooth = parse_s(kend, se, line); return;
+      case Kw::G: c.cur_group = parse_group(kend, se, line), tags_changed = true; return;
+      case Kw::S: c.cur_smooth = parse_s(kend, se, line), tags_changed = true; return;
       case Kw::Mtllib: c.mtllibs.emplace_back(line, std::string(rest_as_name(kend, se))); return;
       default: unknown(p, kend, line); return;
     }
@@ -490,9 +491,7 @@ struct ChunkParser {
     t.t[0] = a.t, t.t[1] = b.t, t.t[2] = d.t;
     t.n[0] = a.n, t.n[1] = b.n, t.n[2] = d.n;
     t.material = c.cur_mat;
-    t.group = c.cur_group;
-    t.object = c.cur_object;
-    t.smoothing = c.cur_smooth;
+    if (tags_changed) open_run();
     if (serial) {
       if (m.triangles.size() == m.triangles.capacity()) grow_triangles();
       m.triangles.push_back(t);
@@ -501,6 +500,16 @@ struct ChunkParser {
       if (itri >= c.ntris) throw std::logic_error("obj_loader: count and parse passes disagree");
       m.triangles[size_t(c.base_tri + itri++)] = t;
     }
+  }
+
+  // Before the first triangle after g / o / s: a new run if the tags differ.
+  bool tags_changed = true;
+  void open_run() {
+    tags_changed = false;
+    const TriangleRun r{serial ? m.triangles.size() : size_t(itri), c.cur_group, c.cur_object, c.cur_smooth};
+    if (c.runs.empty() || c.runs.back().group != r.group || c.runs.back().object != r.object ||
+        c.runs.back().smoothing != r.smoothing)
+      c.runs.push_back(r);
   }
 
   // Serial: gnormal of the triangles emitted since the last call, in blocks
@@ -744,12 +753,8 @@ void finish_chunk(Chunk& c, Mesh& m, bool first) {
   MeshTriangle* t = m.triangles.data() + c.base_tri;
   MeshTriangle* const e = t + c.ntris;
   for (; t < e; ++t) {
-    if (!first) {  // the first chunk's tables are the global ones and it inherits nothing
+    if (!first)  // the first chunk's tables are the global ones and it inherits nothing
       t->material = fix(t->material, c.mat_map, c.in_mat);
-      t->group = fix(t->group, c.group_map, c.in_group);
-      t->object = fix(t->object, c.object_map, c.in_object);
-      t->smoothing = t->smoothing == kInherit ? c.in_smooth : t->smoothing;
-    }
     t->gnormal = face_normal(m.positions, t->v);
   }
 }
@@ -773,6 +778,13 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
       return v == kInherit ? inherited : v < 0 ? v : map[size_t(v)];
     };
     c.in_mat = s_mat, c.in_group = s_group, c.in_object = s_object, c.in_smooth = s_smooth;
+    for (const auto& r : c.runs) {
+      const TriangleRun g{size_t(c.base_tri) + r.first, fix(r.group, c.group_map, s_group),
+                          fix(r.object, c.object_map, s_object), r.smoothing == kInherit ? s_smooth : r.smoothing};
+      if (m.runs.empty() || m.runs.back().group != g.group || m.runs.back().object != g.object ||
+          m.runs.back().smoothing != g.smoothing)
+        m.runs.push_back(g);
+    }
     s_mat = fix(c.cur_mat, c.mat_map, s_mat);
     s_group = fix(c.cur_group, c.group_map, s_group);
     s_object = fix(c.cur_object, c.object_map, s_object);

@@ -318,18 +318,19 @@ TEST(ObjGrouping, ObjectsGroupsSmoothingAndMaterials) {
   EXPECT_EQ(m.groups, (std::vector<std::string>{"left right", "other"}));
   const auto& t = m.triangles;
   EXPECT_EQ(t[0].material, -1);
-  EXPECT_EQ(t[0].group, -1);
-  EXPECT_EQ(t[0].object, -1);
-  EXPECT_EQ(t[0].smoothing, 0);
+  EXPECT_EQ(m.run_of(0).group, -1);
+  EXPECT_EQ(m.run_of(0).object, -1);
+  EXPECT_EQ(m.run_of(0).smoothing, 0);
   EXPECT_EQ(t[1].material, 1);
-  EXPECT_EQ(t[1].group, 0);
-  EXPECT_EQ(t[1].object, 0);
-  EXPECT_EQ(t[1].smoothing, 1);
+  EXPECT_EQ(m.run_of(1).group, 0);
+  EXPECT_EQ(m.run_of(1).object, 0);
+  EXPECT_EQ(m.run_of(1).smoothing, 1);
   EXPECT_EQ(t[2].material, 0);
-  EXPECT_EQ(t[2].group, 1);
-  EXPECT_EQ(t[2].smoothing, 0);
-  EXPECT_EQ(t[3].group, 0);
-  EXPECT_EQ(t[3].object, 0);
+  EXPECT_EQ(m.run_of(2).group, 1);
+  EXPECT_EQ(m.run_of(2).smoothing, 0);
+  EXPECT_EQ(m.run_of(3).group, 0);
+  EXPECT_EQ(m.run_of(3).object, 0);
+  EXPECT_EQ(m.runs.size(), 4u);  // every triangle changes group, object or smoothing
   EXPECT_TRUE(m.warnings.empty()) << m.warnings[0];
 }
 
@@ -461,15 +462,13 @@ void expect_same(const Mesh& a, const Mesh& b) {
     ASSERT_EQ(0, std::memcmp(s.n, t.n, sizeof s.n)) << i;
     ASSERT_EQ(0, std::memcmp(s.t, t.t, sizeof s.t)) << i;
     ASSERT_EQ(s.material, t.material) << i;
-    ASSERT_EQ(s.group, t.group) << i;
-    ASSERT_EQ(s.object, t.object) << i;
-    ASSERT_EQ(s.smoothing, t.smoothing) << i;
     ASSERT_EQ(s.gnormal, t.gnormal) << i;
   }
   std::vector<std::string> an, bn;
   for (auto& m : a.materials) an.push_back(m.name);
   for (auto& m : b.materials) bn.push_back(m.name);
   EXPECT_EQ(an, bn);
+  EXPECT_EQ(a.runs, b.runs);
   EXPECT_EQ(a.groups, b.groups);
   EXPECT_EQ(a.objects, b.objects);
   EXPECT_EQ(a.skipped.vp, b.skipped.vp);
