@@ -263,7 +263,8 @@ struct ChunkParser {
       // plain numbers on one line; anything else (or any doubt) returns
       // nullptr and the general statement parser takes the line.
       const char* q = nullptr;
-      if (end - p > 2 && p[1] == ' ') {
+      if (end - p >= kWideReadable && p[1] == ' ' && (p[0] == 'v' || p[0] == 'f')) q = wide_line(p, end);
+      if (!q && end - p > 2 && p[1] == ' ') {
         if (p[0] == 'v') q = fast_v(p + 2, end);
         else if (p[0] == 'f') q = fast_f(p + 2, end);
       }
@@ -278,6 +279,114 @@ struct ChunkParser {
       line += extra + 1;
       p = se + 1;
     }
+  }
+
+  // The widest fast path: one `v x y z` or `f a b c` line that fits in 64
+  // bytes, with single spaces. Its spaces and line end are found at once
+  // (SSE2 compares over 64 bytes), so the next line's start and every
+  // token's start are known before any value is parsed: the values no longer
+  // wait on each other (a chain of dependent loads, one token after the
+  // next, was the main cost of the byte-by-byte parse). Each token must be
+  // consumed exactly; anything else returns nullptr for the slower paths.
+  static constexpr long kWideReadable = 64 + 16;  // the masks and eight_digits read ahead
+  const char* wide_line(const char* p, const char* end) {
+#if defined(__SSE2__)
+    (void)end;
+    const __m128i SP = _mm_set1_epi8(' '), NL = _mm_set1_epi8('\n');
+    std::uint64_t sp = 0, nl = 0;
+    for (int i = 0; i < 4; ++i) {
+      const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16 * i));
+      sp |= std::uint64_t(unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(x, SP)))) << (16 * i);
+      nl |= std::uint64_t(unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(x, NL)))) << (16 * i);
+    }
+    if (!nl) return nullptr;
+    const int len = __builtin_ctzll(nl);  // p[len] == '\n'
+    sp &= (std::uint64_t(1) << len) - 1;
+    // exactly three spaces: p[1], then two more
+    if ((sp & 3) != 2) return nullptr;
+    const std::uint64_t r1 = sp & (sp - 1), r2 = r1 & (r1 - 1);
+    if (!r1 || !r2 || (r2 & (r2 - 1))) return nullptr;
+    const int s1 = __builtin_ctzll(r1), s2 = __builtin_ctzll(r2);
+    const int last = p[len - 1] == '\r' ? len - 1 : len;  // end of the third token
+    if (s1 == 2 || s2 == s1 + 1 || last <= s2 + 1) return nullptr;  // an empty token
+    if (p[0] == 'v') {
+      double x[3];
+      const char *a = p + 2, *b = p + s1 + 1, *c = p + s2 + 1;
+      if (!wide_double(a, p + s1, end, x[0]) || !wide_double(b, p + s2, end, x[1]) ||
+          !wide_double(c, p + last, end, x[2]))
+        return nullptr;
+      put_position({x[0], x[1], x[2]});
+    } else {
+      Corner k[3];
+      const long nv = c.base_v + iv, nvt = c.base_vt + ivt, nvn = c.base_vn + ivn;
+      if (!wide_corner(p + 2, p + s1, nv, nvt, nvn, k[0]) || !wide_corner(p + s1 + 1, p + s2, nv, nvt, nvn, k[1]) ||
+          !wide_corner(p + s2 + 1, p + last, nv, nvt, nvn, k[2]))
+        return nullptr;
+      if ((k[0].t < 0) != (k[1].t < 0) || (k[0].t < 0) != (k[2].t < 0) || (k[0].n < 0) != (k[1].n < 0) ||
+          (k[0].n < 0) != (k[2].n < 0))
+        return nullptr;  // mixed forms: the general path warns
+      emit(k[0], k[1], k[2]);
+    }
+    return p + len + 1;
+#else
+    (void)p, (void)end;
+    return nullptr;
+#endif
+  }
+  // The number filling exactly [b, e) (8 bytes past each digit run
+  // readable): `[-]i.f` or `[-]i` with fewer than 8 digits each side
+  // inline, at most 14 digits so the mantissa is exact and one division
+  // (by 1 for integers) rounds it correctly; anything else via fast_double.
+  [[gnu::always_inline]] static bool wide_double(const char* b, const char* e, const char* end, double& out) {
+    static constexpr double kPow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7};
+    static constexpr std::uint64_t kP10[] = {1, 10, 100, 1000, 10000, 100000, 1000000, 10000000};
+    const char* s = b;
+    const bool neg = *s == '-';
+    s += neg;
+    std::uint64_t ip, fp = 0;
+    const int ni = eight_digits(s, ip);
+    int nf = 0;
+    if (ni < 8 && s[ni] == '.') {
+      nf = eight_digits(s + ni + 1, fp);
+      if (nf == 8 || s + ni + 1 + nf != e || ni + nf == 0) return generic_double(b, e, end, out);
+    } else if (ni == 0 || ni == 8 || s + ni != e) {
+      return generic_double(b, e, end, out);
+    }
+    const double v = double(ip * kP10[nf] + fp) / kPow10[nf];
+    out = neg ? -v : v;
+    return true;
+  }
+  static bool generic_double(const char* b, const char* e, const char* end, double& out) {
+    return fast_double(b, end, out) && b == e;
+  }
+  // One index of at most 7 digits at b (8 bytes readable), 1-based or
+  // negative, checked against count; b moves past it.
+  [[gnu::always_inline]] static bool wide_index(const char*& b, long count, int& out) {
+    const bool neg = *b == '-';
+    b += neg;
+    std::uint64_t v;
+    const int n = eight_digits(b, v);
+    if (n == 0 || n == 8) return false;
+    b += n;
+    if (v == 0 || long(v) > count) return false;
+    out = int(neg ? count - long(v) : long(v) - 1);
+    return true;
+  }
+  // v, v/t, v//n or v/t/n filling exactly [b, e).
+  [[gnu::always_inline]] static bool wide_corner(const char* b, const char* e, long nv, long nvt, long nvn, Corner& k) {
+    k.t = k.n = -1;
+    if (!wide_index(b, nv, k.v)) return false;
+    if (*b == '/') {
+      ++b;
+      if (*b == '/') {
+        ++b;
+        if (!wide_index(b, nvn, k.n)) return false;
+      } else {
+        if (!wide_index(b, nvt, k.t)) return false;
+        if (*b == '/' && !wide_index(++b, nvn, k.n)) return false;
+      }
+    }
+    return b == e;
   }
 
   // After a fast-path statement: blanks and CRs, then the line end.
