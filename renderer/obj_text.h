@@ -100,7 +100,7 @@ inline bool starts_with_ci(const char* p, const char* end, const char* word) {
 // load, the run length from a carry-free per-byte compare, the value from
 // three multiplies, as in fast_float's parse_eight_digits_unrolled).
 // Returns how many digits (0..8) and their value.
-inline int eight_digits(const char* p, std::uint64_t& value) {
+[[gnu::always_inline]] inline int eight_digits(const char* p, std::uint64_t& value) {
   std::uint64_t x;
   std::memcpy(&x, p, 8);
   if constexpr (std::endian::native == std::endian::big) x = __builtin_bswap64(x);
