@@ -119,6 +119,12 @@ struct Chunk {
   NameTable mats, groups, objects;
   int cur_mat = kInherit, cur_group = kInherit, cur_object = kInherit, cur_smooth = kInherit;
   std::vector<TriangleRun> runs;  // chunk-local: first counts from the chunk's first triangle
+  // step 0: the chunk's last `usemtl` name, if any, so that every chunk can
+  // start with the material in force (and need no fixing when ids agree)
+  bool has_usemtl = false;
+  std::string last_usemtl;
+  // parallel: triangles whose gnormal needs positions of an earlier chunk
+  std::vector<long> late_normals;
   long vp = 0, l = 0, p = 0;
   std::vector<std::pair<long, std::string>> mtllibs;
   std::vector<Unknown> unknown;
@@ -150,11 +156,73 @@ long count_corners(const char* p, const char* se) {
   }
 }
 
+// count_corners for a statement of at most 48 bytes with 64 readable: with
+// no tab, `#` or `\\` in it, tokens are the non-blank bytes after a blank.
+long count_corners_short(const char* p, const char* se) {
+#if defined(__SSE2__)
+  std::uint64_t blank = 0, odd = 0;
+  for (int i = 0; i < 4; ++i) {
+    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16 * i));
+    const __m128i b = _mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8(' ')), _mm_cmpeq_epi8(x, _mm_set1_epi8('\r')));
+    const __m128i o = _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8('\t')), _mm_cmpeq_epi8(x, _mm_set1_epi8('#'))),
+                                   _mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8('\\')), _mm_cmpeq_epi8(x, _mm_set1_epi8('\v'))));
+    blank |= std::uint64_t(unsigned(_mm_movemask_epi8(b))) << (16 * i);
+    odd |= std::uint64_t(unsigned(_mm_movemask_epi8(_mm_or_si128(o, _mm_cmpeq_epi8(x, _mm_set1_epi8('\f')))))) << (16 * i);
+  }
+  const std::uint64_t in = (std::uint64_t(1) << (se - p)) - 1;
+  if (odd & in) return count_corners(p, se);
+  // p (the keyword's end) is a blank or se, so every token follows a blank
+  return __builtin_popcountll(~blank & (blank << 1) & in);
+#else
+  return count_corners(p, se);
+#endif
+}
+
 // Step 0 (parallel only): counts statements, lines and triangles of a chunk.
 void count_chunk(Chunk& c) {
   const char* p = c.begin;
   long line = 0;
   while (p < c.end) {
+#if defined(__SSE2__)
+    // One physical line of under 64 bytes with no tab, `#`, `\\`, VT or FF
+    // (so no continuation and no comment) starting `v `, `vt `, `vn ` or
+    // `f `: classified and its corners counted from masks.
+    if (c.end - p >= 80) {
+      std::uint64_t nl = 0, blank = 0, odd = 0;
+      for (int i = 0; i < 4; ++i) {
+        const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16 * i));
+        auto eq = [&](char ch) { return _mm_cmpeq_epi8(x, _mm_set1_epi8(ch)); };
+        nl |= std::uint64_t(unsigned(_mm_movemask_epi8(eq('\n')))) << (16 * i);
+        blank |= std::uint64_t(unsigned(_mm_movemask_epi8(_mm_or_si128(eq(' '), eq('\r'))))) << (16 * i);
+        const __m128i o = _mm_or_si128(_mm_or_si128(eq('\t'), eq('#')), _mm_or_si128(eq('\\'), _mm_or_si128(eq('\v'), eq('\f'))));
+        odd |= std::uint64_t(unsigned(_mm_movemask_epi8(o))) << (16 * i);
+      }
+      if (nl) {
+        const int len = __builtin_ctzll(nl);
+        const std::uint64_t in = (std::uint64_t(1) << len) - 1;
+        if (!(odd & in) && len >= 2) {
+          bool known = true;
+          if (p[0] == 'v' && (blank & 2)) {
+            ++c.nv;
+          } else if (p[0] == 'v' && (p[1] == 't' || p[1] == 'n') && (len == 2 || (blank & 4))) {
+            ++(p[1] == 't' ? c.nvt : c.nvn);
+          } else if (p[0] == 'f' && (blank & 2)) {
+            std::uint64_t tok = ~blank & (blank << 1) & in;
+            long n = 0;
+            for (; tok; tok &= tok - 1) ++n;
+            c.ntris += n > 2 ? n - 2 : 0;
+          } else {
+            known = false;
+          }
+          if (known) {
+            ++line;
+            p += len + 1;
+            continue;
+          }
+        }
+      }
+    }
+#endif
     const char* se = statement_end(p, c.end, line);
     const char* kend = nullptr;
     const char* s = p;
@@ -162,8 +230,12 @@ void count_chunk(Chunk& c) {
       case Kw::V: ++c.nv; break;
       case Kw::VT: ++c.nvt; break;
       case Kw::VN: ++c.nvn; break;
+      case Kw::Usemtl:
+        c.has_usemtl = true;
+        c.last_usemtl = std::string(rest_as_name(kend, se));
+        break;
       case Kw::F: {
-        const long n = count_corners(kend, se);
+        const long n = se - kend <= 48 && c.end - kend >= 64 ? count_corners_short(kend, se) : count_corners(kend, se);
         c.ntris += n > 2 ? n - 2 : 0;
         break;
       }
@@ -608,7 +680,23 @@ struct ChunkParser {
     } else {
       if (itri >= c.ntris) throw std::logic_error("obj_loader: count and parse passes disagree");
       m.triangles[size_t(c.base_tri + itri++)] = t;
+      if (size_t(itri) - normals_done >= kNormalBlock) finish_chunk_normals();
     }
+  }
+
+  // Parallel: gnormal of the triangles since the last call whose corners
+  // are this chunk's own positions (written already); the others wait.
+  void finish_chunk_normals() {
+    MeshTriangle* t = m.triangles.data() + c.base_tri;
+    const unsigned long lo = (unsigned long)c.base_v, n = (unsigned long)iv;
+    for (size_t i = normals_done; i < size_t(itri); ++i) {
+      const int* v = t[i].v;
+      if ((unsigned long)v[0] - lo < n && (unsigned long)v[1] - lo < n && (unsigned long)v[2] - lo < n)
+        t[i].gnormal = face_normal(m.positions, v);
+      else
+        c.late_normals.push_back(c.base_tri + long(i));
+    }
+    normals_done = size_t(itri);
   }
 
   // Before the first triangle after g / o / s: a new run if the tags differ.
@@ -856,16 +944,21 @@ void finish_chunk(Chunk& c, Mesh& m, bool first) {
       }
     }
   }
-  auto fix = [](int v, const std::vector<int>& map, int inherited) {
-    return v == kInherit ? inherited : v < 0 ? v : map[size_t(v)];
-  };
+  for (const auto& d : c.deferred)
+    for (int k = 0; k < d.n - 2; ++k) {
+      MeshTriangle& t = m.triangles[size_t(d.tri + k)];
+      t.gnormal = face_normal(m.positions, t.v);
+    }
+  for (long i : c.late_normals) m.triangles[size_t(i)].gnormal = face_normal(m.positions, m.triangles[size_t(i)].v);
+  // Every chunk started with the material in force, so only local ids that
+  // differ from the global ones need rewriting.
+  bool identity = true;
+  for (size_t i = 0; i < c.mat_map.size(); ++i) identity = identity && c.mat_map[i] == int(i);
+  if (first || identity) return;
   MeshTriangle* t = m.triangles.data() + c.base_tri;
   MeshTriangle* const e = t + c.ntris;
-  for (; t < e; ++t) {
-    if (!first)  // the first chunk's tables are the global ones and it inherits nothing
-      t->material = fix(t->material, c.mat_map, c.in_mat);
-    t->gnormal = face_normal(m.positions, t->v);
-  }
+  for (; t < e; ++t)
+    if (t->material >= 0) t->material = c.mat_map[size_t(t->material)];
 }
 
 // Step 2: global name tables, the state each chunk inherits, warnings; in
@@ -967,14 +1060,26 @@ Mesh parse_parallel(std::string_view text, const std::string& name, const ObjOpt
   constexpr long kMaxCount = 0x7fffffffL;
   if (v > kMaxCount || vt > kMaxCount || vn > kMaxCount)
     throw InputError(located(name, 0, "more than 2^31-1 vertices, uvs or normals"));
+  m.positions.reserve(size_t(v));
+  m.uvs.reserve(size_t(vt));
+  m.normals.reserve(size_t(vn));
+  m.triangles.reserve(size_t(nt));
+  advise_huge(m.positions), advise_huge(m.uvs), advise_huge(m.normals), advise_huge(m.triangles);
   m.positions.resize(size_t(v));
   m.uvs.resize(size_t(vt));
   m.normals.resize(size_t(vn));
   m.triangles.resize(size_t(nt));
+  bool has_mat = false;
+  std::string mat;
+  for (auto& c : chunks) {
+    c.cur_mat = has_mat && !mat.empty() ? c.mats.intern(mat, c.first_line) : -1;
+    if (c.has_usemtl) has_mat = true, mat = c.last_usemtl;
+  }
   const Where w{&name};
   run_parallel(chunks, [&](Chunk& c) {
     ChunkParser cp{c, m, w, false};
     cp.run();
+    cp.finish_chunk_normals();
     if (cp.itri != c.ntris) throw std::logic_error("obj_loader: count and parse passes disagree");
   });
   if (any_error(chunks)) return parse_serial(text, name, opt);  // the serial message
