@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <random>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -239,6 +242,38 @@ TEST(ObjNumbers, AllForms) {
   const Bounds3d b = m.bbox();
   EXPECT_EQ(b.min, Vec3d(-0.0, -0.5, 0));
   EXPECT_EQ(b.max, Vec3d(100, 100, 2));
+}
+
+// The parser's fast paths (Clinger's, SWAR digit runs, whole-line masks)
+// must give exactly std::from_chars's double. Seeded; prints the seed.
+TEST(ObjNumbers, FastPathsMatchFromCharsExactly) {
+  const unsigned seed = 20261121;
+  std::mt19937_64 rnd(seed);
+  std::string text;
+  std::vector<std::string> tokens;
+  char buf[64];
+  for (int i = 0; i < 30000; ++i) {
+    const double mag = std::pow(10.0, double(int(rnd() % 40)) - 20.0);
+    const double x = (double(rnd() % 2000001) / 1e6 - 1.0) * mag;
+    switch (rnd() % 4) {
+      case 0: std::snprintf(buf, sizeof buf, "%.*f", int(rnd() % 12), x); break;
+      case 1: std::snprintf(buf, sizeof buf, "%.*e", int(rnd() % 18), x); break;
+      case 2: std::snprintf(buf, sizeof buf, "%.*g", int(1 + rnd() % 17), x); break;
+      default: std::snprintf(buf, sizeof buf, "%lld.%0*llu", (long long)(rnd() % 100000000) - 50000000,
+                             int(rnd() % 10), (unsigned long long)(rnd() % 10000000000ull)); break;
+    }
+    tokens.push_back(buf);
+  }
+  for (size_t i = 0; i + 3 <= tokens.size(); i += 3) text += "v " + tokens[i] + " " + tokens[i + 1] + " " + tokens[i + 2] + "\n";
+  const Mesh m = parse_obj(text, "n.obj");
+  ASSERT_EQ(m.positions.size(), tokens.size() / 3);
+  for (size_t i = 0; i + 3 <= tokens.size(); ++i) {
+    double want = 0;
+    std::from_chars(tokens[i].data(), tokens[i].data() + tokens[i].size(), want);
+    const Vec3d& p = m.positions[i / 3];
+    const double got = i % 3 == 0 ? p.x : i % 3 == 1 ? p.y : p.z;
+    ASSERT_EQ(0, std::memcmp(&want, &got, sizeof got)) << "seed " << seed << ": '" << tokens[i] << "' gave " << got;
+  }
 }
 
 TEST(ObjNumbers, NonFiniteAndMalformedAreErrors) {
