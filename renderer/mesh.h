@@ -47,17 +47,23 @@
 namespace ra {
 
 // 0-based indices, -1 where absent. gnormal = normalize((B-A) x (C-A)), the
-// zero vector for a degenerate triangle. material/group/object index
-// Mesh::materials/groups/objects, -1 = default/none.
+// zero vector for a degenerate triangle. material indexes Mesh::materials,
+// -1 = default. 64 bytes; group, object and smoothing are in Mesh::runs.
 struct MeshTriangle {
   int v[3];
   int n[3];
   int t[3];
   int material;
-  int group;
-  int object;
   Vec3d gnormal;
-  int smoothing = 0;  // `s N` in force (0 = off); added for smooth normals
+};
+
+// Group, object and smoothing group (`s N` in force, 0 = off) of a run of
+// consecutive triangles, indices into Mesh::groups/objects, -1 = none. They
+// change rarely, so they are stored per run rather than per triangle.
+struct TriangleRun {
+  std::size_t first;  // index of the run's first triangle
+  int group = -1, object = -1, smoothing = 0;
+  bool operator==(const TriangleRun&) const = default;
 };
 
 // Phong-style material of an MTL file. Map paths are resolved relative to
@@ -87,6 +93,10 @@ struct Mesh {
   std::vector<Vec3d> positions, normals;
   std::vector<std::array<double, 2>> uvs;
   std::vector<MeshTriangle> triangles;
+  // Maximal runs in triangle order: the first starts at 0, each next one at
+  // the first triangle whose group, object or smoothing differs; empty
+  // exactly when there are no triangles.
+  std::vector<TriangleRun> runs;
   std::vector<MtlMaterial> materials;
   std::vector<std::string> groups, objects;
   struct {
@@ -94,6 +104,8 @@ struct Mesh {
   } skipped;
   std::vector<std::string> warnings;  // each "FILE:LINE: message"
 
+  // The run holding triangle i (i < triangles.size()): a binary search.
+  const TriangleRun& run_of(std::size_t i) const;
   // Box of all positions (referenced or not); empty() when there are none.
   Bounds3d bbox() const;
   // Sum of the triangles' areas, 0.5 |(B-A) x (C-A)| each.

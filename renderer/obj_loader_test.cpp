@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <random>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -241,6 +244,38 @@ TEST(ObjNumbers, AllForms) {
   EXPECT_EQ(b.max, Vec3d(100, 100, 2));
 }
 
+// The parser's fast paths (Clinger's, SWAR digit runs, whole-line masks)
+// must give exactly std::from_chars's double. Seeded; prints the seed.
+TEST(ObjNumbers, FastPathsMatchFromCharsExactly) {
+  const unsigned seed = 20261121;
+  std::mt19937_64 rnd(seed);
+  std::string text;
+  std::vector<std::string> tokens;
+  char buf[64];
+  for (int i = 0; i < 30000; ++i) {
+    const double mag = std::pow(10.0, double(int(rnd() % 40)) - 20.0);
+    const double x = (double(rnd() % 2000001) / 1e6 - 1.0) * mag;
+    switch (rnd() % 4) {
+      case 0: std::snprintf(buf, sizeof buf, "%.*f", int(rnd() % 12), x); break;
+      case 1: std::snprintf(buf, sizeof buf, "%.*e", int(rnd() % 18), x); break;
+      case 2: std::snprintf(buf, sizeof buf, "%.*g", int(1 + rnd() % 17), x); break;
+      default: std::snprintf(buf, sizeof buf, "%lld.%0*llu", (long long)(rnd() % 100000000) - 50000000,
+                             int(rnd() % 10), (unsigned long long)(rnd() % 10000000000ull)); break;
+    }
+    tokens.push_back(buf);
+  }
+  for (size_t i = 0; i + 3 <= tokens.size(); i += 3) text += "v " + tokens[i] + " " + tokens[i + 1] + " " + tokens[i + 2] + "\n";
+  const Mesh m = parse_obj(text, "n.obj");
+  ASSERT_EQ(m.positions.size(), tokens.size() / 3);
+  for (size_t i = 0; i + 3 <= tokens.size(); ++i) {
+    double want = 0;
+    std::from_chars(tokens[i].data(), tokens[i].data() + tokens[i].size(), want);
+    const Vec3d& p = m.positions[i / 3];
+    const double got = i % 3 == 0 ? p.x : i % 3 == 1 ? p.y : p.z;
+    ASSERT_EQ(0, std::memcmp(&want, &got, sizeof got)) << "seed " << seed << ": '" << tokens[i] << "' gave " << got;
+  }
+}
+
 TEST(ObjNumbers, NonFiniteAndMalformedAreErrors) {
   EXPECT_EQ(load_error("v 0 0 0\nv nan 0 0\n"), "t.obj:2: non-finite number 'nan' is not accepted");
   EXPECT_EQ(load_error("v -inf 0 0\n"), "t.obj:1: non-finite number '-inf' is not accepted");
@@ -318,18 +353,19 @@ TEST(ObjGrouping, ObjectsGroupsSmoothingAndMaterials) {
   EXPECT_EQ(m.groups, (std::vector<std::string>{"left right", "other"}));
   const auto& t = m.triangles;
   EXPECT_EQ(t[0].material, -1);
-  EXPECT_EQ(t[0].group, -1);
-  EXPECT_EQ(t[0].object, -1);
-  EXPECT_EQ(t[0].smoothing, 0);
+  EXPECT_EQ(m.run_of(0).group, -1);
+  EXPECT_EQ(m.run_of(0).object, -1);
+  EXPECT_EQ(m.run_of(0).smoothing, 0);
   EXPECT_EQ(t[1].material, 1);
-  EXPECT_EQ(t[1].group, 0);
-  EXPECT_EQ(t[1].object, 0);
-  EXPECT_EQ(t[1].smoothing, 1);
+  EXPECT_EQ(m.run_of(1).group, 0);
+  EXPECT_EQ(m.run_of(1).object, 0);
+  EXPECT_EQ(m.run_of(1).smoothing, 1);
   EXPECT_EQ(t[2].material, 0);
-  EXPECT_EQ(t[2].group, 1);
-  EXPECT_EQ(t[2].smoothing, 0);
-  EXPECT_EQ(t[3].group, 0);
-  EXPECT_EQ(t[3].object, 0);
+  EXPECT_EQ(m.run_of(2).group, 1);
+  EXPECT_EQ(m.run_of(2).smoothing, 0);
+  EXPECT_EQ(m.run_of(3).group, 0);
+  EXPECT_EQ(m.run_of(3).object, 0);
+  EXPECT_EQ(m.runs.size(), 4u);  // every triangle changes group, object or smoothing
   EXPECT_TRUE(m.warnings.empty()) << m.warnings[0];
 }
 
@@ -461,15 +497,13 @@ void expect_same(const Mesh& a, const Mesh& b) {
     ASSERT_EQ(0, std::memcmp(s.n, t.n, sizeof s.n)) << i;
     ASSERT_EQ(0, std::memcmp(s.t, t.t, sizeof s.t)) << i;
     ASSERT_EQ(s.material, t.material) << i;
-    ASSERT_EQ(s.group, t.group) << i;
-    ASSERT_EQ(s.object, t.object) << i;
-    ASSERT_EQ(s.smoothing, t.smoothing) << i;
     ASSERT_EQ(s.gnormal, t.gnormal) << i;
   }
   std::vector<std::string> an, bn;
   for (auto& m : a.materials) an.push_back(m.name);
   for (auto& m : b.materials) bn.push_back(m.name);
   EXPECT_EQ(an, bn);
+  EXPECT_EQ(a.runs, b.runs);
   EXPECT_EQ(a.groups, b.groups);
   EXPECT_EQ(a.objects, b.objects);
   EXPECT_EQ(a.skipped.vp, b.skipped.vp);

@@ -3,7 +3,9 @@
 // read; nothing allocates). A "statement" is one logical line: physical lines
 // joined by a `\` right before their end (LF or CRLF).
 #pragma once
+#include <bit>
 #include <charconv>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -94,26 +96,96 @@ inline bool starts_with_ci(const char* p, const char* end, const char* word) {
   return true;
 }
 
-// Clinger's fast path: [sign] digits [. digits] with at most 19 digits, a
-// mantissa <= 2^53 and at most 22 decimals is mantissa / 10^k, one correctly
-// rounded division of exact values, so the same double from_chars gives.
-// Returns false (p unchanged) for anything else (exponents, long numbers).
+// Up to 8 ASCII digits at p, 8 bytes of which must be readable (SWAR: one
+// load, the run length from a carry-free per-byte compare, the value from
+// three multiplies, as in fast_float's parse_eight_digits_unrolled).
+// Returns how many digits (0..8) and their value.
+[[gnu::always_inline]] inline int eight_digits(const char* p, std::uint64_t& value) {
+  std::uint64_t x;
+  std::memcpy(&x, p, 8);
+  if constexpr (std::endian::native == std::endian::big) x = __builtin_bswap64(x);
+  const std::uint64_t t = x ^ 0x3030303030303030ull;  // digits become bytes 0..9
+  // A byte > 9 gets its top bit from t + 0x76 (no carry out of a byte <= 9,
+  // so the lowest flagged byte is exact) or, if >= 0x80, from t itself.
+  const std::uint64_t nd = ((t + 0x7676767676767676ull) | t) & 0x8080808080808080ull;
+  const int n = nd ? __builtin_ctzll(nd) >> 3 : 8;
+  if (n == 0) {
+    value = 0;
+    return 0;
+  }
+  std::uint64_t v = t << (8 * (8 - n));  // leading zeros in the low bytes
+  v = v * 10 + (v >> 8);
+  v = (((v & 0x000000FF000000FFull) * (100 + (1000000ull << 32))) +
+       (((v >> 16) & 0x000000FF000000FFull) * (1 + (10000ull << 32)))) >>
+      32;
+  value = v;
+  return n;
+}
+
+// Reads a run of decimal digits at s (advancing it): mant = mant * 10^k +
+// digits, digits += k. mant wraps silently past 19 digits: callers reject
+// those by the count.
+inline void read_digits(const char*& s, const char* end, std::uint64_t& mant, int& digits) {
+  static constexpr std::uint64_t kP10[] = {1, 10, 100, 1000, 10000, 100000, 1000000, 10000000, 100000000};
+  while (end - s >= 8) {
+    std::uint64_t v;
+    const int n = eight_digits(s, v);
+    mant = mant * kP10[n] + v;
+    digits += n;
+    s += n;
+    if (n < 8) return;
+  }
+  while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits;
+}
+
+// Clinger's fast path: [sign] digits [. digits] [e [sign] digits] with at
+// most 19 significant-or-not digits, a mantissa <= 2^53 and a power of ten
+// |e| <= 22 is mantissa x 10^e or mantissa / 10^-e, one correctly rounded
+// operation on exact values, so the same double from_chars gives. Returns
+// false (p unchanged) for anything else (long numbers, large exponents, a
+// malformed exponent): the caller then uses from_chars.
 inline bool fast_double(const char*& p, const char* end, double& out) {
   static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                       1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
   const char* s = p;
   bool neg = false;
   if (s < end && (*s == '-' || *s == '+')) neg = *s++ == '-';
-  unsigned long long mant = 0;
+  std::uint64_t mant = 0;
   int digits = 0, frac = 0;
-  while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits;
-  if (s < end && *s == '.') {
-    ++s;
-    while (s < end && unsigned(*s - '0') < 10) mant = mant * 10 + unsigned(*s++ - '0'), ++digits, ++frac;
+  std::uint64_t ip, fp;
+  int ni, nf;
+  if (end - s >= 17 && (ni = eight_digits(s, ip)) < 8 && s[ni] == '.' && (nf = eight_digits(s + ni + 1, fp)) < 8) {
+    // the usual short `i.f` (under 8 digits each side): two loads, no loops
+    static constexpr std::uint64_t kP10[] = {1, 10, 100, 1000, 10000, 100000, 1000000, 10000000};
+    mant = ip * kP10[nf] + fp;
+    digits = ni + nf, frac = nf;
+    s += ni + 1 + nf;
+  } else {
+    read_digits(s, end, mant, digits);
+    if (s < end && *s == '.') {
+      ++s;
+      const int before = digits;
+      read_digits(s, end, mant, digits);
+      frac = digits - before;
+    }
   }
-  if (digits == 0 || digits > 19 || mant > (1ull << 53) || frac > 22) return false;
-  if (s < end && (*s == 'e' || *s == 'E')) return false;
-  const double v = frac ? double(mant) / kPow10[frac] : double(mant);
+  if (digits == 0 || digits > 19 || mant > (1ull << 53)) return false;
+  int e10 = -frac;
+  if (s < end && (*s == 'e' || *s == 'E')) {
+    ++s;
+    bool eneg = false;
+    if (s < end && (*s == '-' || *s == '+')) eneg = *s++ == '-';
+    const char* d = s;
+    int e = 0;
+    while (s < end && unsigned(*s - '0') < 10 && s - d < 4) e = e * 10 + (*s++ - '0');
+    if (s == d || (s < end && unsigned(*s - '0') < 10)) return false;  // no digits, or more than 4
+    e10 += eneg ? -e : e;
+  }
+  double v;
+  if (mant == 0) v = 0;
+  else if (e10 < 0 && e10 >= -22) v = double(mant) / kPow10[-e10];
+  else if (e10 >= 0 && e10 <= 22) v = double(mant) * kPow10[e10];
+  else return false;
   out = neg ? -v : v;
   p = s;
   return true;
