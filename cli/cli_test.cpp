@@ -4,11 +4,16 @@
 
 #include "run_rayaudit.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <vector>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "image.h"
 
@@ -66,11 +71,61 @@ TEST(Cli, BadSceneExits2WithFileAndPath) {
   EXPECT_FALSE(fs::exists(dir / "bad.png"));
 }
 
+// The method names of issue 3, by kind: the CLI's names are a contract.
+const std::vector<std::string> kTriangleMethods = {"angles", "cramer", "areas", "triple",
+                                                   "sameside", "moller", "watertight", "baldwin"};
+const std::vector<std::string> kSphereMethods = {"kraus", "codeproject", "codeproject-fixed", "stable"};
+
 TEST(Cli, UnknownMethodExits2ListingTheValidOnes) {
+  const fs::path out = temp_dir() / "m.png";
   const Result r = run(std::string("render ") + RAYAUDIT_SOURCE_DIR + "/scenes/sphere-on-plane.json -o " +
-                       (temp_dir() / "m.png").string() + " --method nosuch");
+                       out.string() + " --method nosuch");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.out.find("moller"), std::string::npos) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << "one line: " << r.out;
+  for (const auto& name : kTriangleMethods) EXPECT_NE(r.out.find(name), std::string::npos) << name;
+  for (const auto& name : kSphereMethods) EXPECT_NE(r.out.find(name), std::string::npos) << name;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, MethodsJsonListsEightTriangleFourSphereAndOnePlaneMethod) {
+  const auto r = ra::test::run_rayaudit("methods --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.is_array());
+  std::map<std::string, std::vector<std::string>> by_kind;
+  for (const auto& m : j) {
+    ASSERT_TRUE(m.contains("name") && m.contains("kind") && m.contains("source")) << m.dump();
+    EXPECT_FALSE(m["source"].get<std::string>().empty()) << m.dump();
+    by_kind[m["kind"].get<std::string>()].push_back(m["name"].get<std::string>());
+  }
+  EXPECT_EQ(by_kind["triangle"], kTriangleMethods);
+  EXPECT_EQ(by_kind["sphere"], kSphereMethods);
+  EXPECT_EQ(by_kind["plane"].size(), 1u);
+  EXPECT_EQ(by_kind.size(), 3u);
+}
+
+// Every method by name, in both precisions, with culling: each render
+// succeeds and writes its image. `--method NAME` may come before SCENE.
+TEST(Cli, RendersWithEveryMethodInBothPrecisionsAndWithCulling) {
+  const fs::path dir = temp_dir();
+  const std::string scene = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/sphere-on-plane.json";
+  std::vector<std::string> names = kTriangleMethods;
+  names.insert(names.end(), kSphereMethods.begin(), kSphereMethods.end());
+  for (const auto& name : names)
+    for (const char* precision : {"float", "double"}) {
+      const fs::path out = dir / (name + "-" + precision + ".png");
+      const Result r = run("render --method " + name + " " + scene + " -o " + out.string() +
+                           " --width 32 --height 24 --cull --precision " + precision);
+      EXPECT_EQ(r.code, 0) << name << " " << precision << ": " << r.out;
+      EXPECT_TRUE(fs::exists(out)) << out;
+    }
+  const Result two = run("render " + scene + " -o " + (dir / "two.png").string() +
+                         " --method kraus --method stable");
+  EXPECT_EQ(two.code, 2);
+  EXPECT_NE(two.out.find("two sphere methods"), std::string::npos) << two.out;
+  const Result bad = run("render " + scene + " -o " + (dir / "p.png").string() + " --precision half");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_FALSE(fs::exists(dir / "p.png"));
 }
 
 TEST(Cli, UsageErrorsExit2AndHelpExits0) {

@@ -27,14 +27,23 @@ int samples_per_axis(int spp) {
 
 void run(const Args& a) {
   ra::RenderOptions opt;
+  // At most one method per primitive kind: a second one of the same kind
+  // would silently replace the first. The plane has one method only.
+  const ra::Method* chosen_triangle = nullptr;
+  const ra::Method* chosen_sphere = nullptr;
   for (const auto& name : a.methods) {
     const ra::Method* m = ra::find_method(name);
-    if (!m)
-      throw ra::InputError("unknown method \"" + name + "\"; triangle methods: " +
+    if (!m || m->kind == ra::Kind::plane)
+      throw ra::InputError("unknown method \"" + name + "\" for --method; triangle methods: " +
                            ra::method_names(ra::Kind::triangle) +
                            "; sphere methods: " + ra::method_names(ra::Kind::sphere));
+    const ra::Method*& slot = m->kind == ra::Kind::triangle ? chosen_triangle : chosen_sphere;
+    if (slot && slot != m)
+      throw ra::InputError("--method given two " + std::string(m->kind == ra::Kind::triangle ? "triangle" : "sphere") +
+                           " methods (\"" + std::string(slot->name) + "\" and \"" + name + "\"); give one of each kind");
+    slot = m;
     if (m->kind == ra::Kind::triangle) opt.triangle_method = name;
-    else if (m->kind == ra::Kind::sphere) opt.sphere_method = name;
+    else opt.sphere_method = name;
   }
   if (a.precision == "float") opt.use_double = false;
   else if (a.precision != "double")
@@ -77,8 +86,8 @@ void setup(CLI::App& app) {
       ->check(CLI::Range(1, 256));
   cmd->add_option("--method", args->methods,
                   "Intersection method by name (see `rayaudit methods`); a triangle and a sphere "
-                  "method may both be given")
-      ->take_all();
+                  "method may both be given, as two --method options")
+      ->allow_extra_args(false);  // one name per --method: `--method kraus SCENE` keeps SCENE
   cmd->add_option("--precision", args->precision, "Intersection precision: float or double (default double)");
   cmd->add_flag("--cull", args->cull, "Backface culling of triangles");
   cmd->add_option("--accel", args->accel, "Acceleration: bvh (default), sphere (document 002's bounding sphere) or none");

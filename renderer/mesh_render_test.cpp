@@ -4,6 +4,7 @@
 // nothing, the MTL -> finish mapping, and mesh placement.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include "bvh.h"
 #include "camera.h"
 #include "image.h"
+#include "methods/areas.h"
 #include "registry.h"
 #include "render.h"
 #include "scene_mesh.h"
@@ -391,6 +393,143 @@ TEST(Accel, CullingChangesNothingOnClosedMeshesSeenFromOutside) {
       }
     }
   }
+}
+
+// The closedness test behind --cull, on sets whose answer is known by
+// construction: the uv sphere above is closed and outward (its faces are
+// written counter-clockwise seen from outside); the same with every face
+// reversed faces inward; an open quad and document 004's cube (6 of its 12
+// listed faces wind inward, e.g. `f 5 8 7` against `f 1 4 3`) are not safe.
+TEST(Cull, OnlyClosedOutwardMeshesAreCulled) {
+  const auto dir = temp_dir();
+  auto load = [&](const std::string& name, const std::string& text) {
+    write_text(dir / name, text);
+    MeshPlacement place;
+    place.file = dir / name;
+    return load_placed_mesh(place);
+  };
+  const auto ball = load("ball.obj", uv_sphere_obj(8, 12, false));
+  EXPECT_EQ(cull_unsafe_reason(*ball), "");
+  TriangleSet inverted = *ball;
+  for (auto& t : inverted.triangles) std::swap(t.v[1], t.v[2]);
+  EXPECT_NE(cull_unsafe_reason(inverted).find("inward"), std::string::npos);
+  const auto quad = load("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+  EXPECT_NE(cull_unsafe_reason(*quad).find("not closed"), std::string::npos);
+  MeshPlacement cube;
+  cube.file = std::filesystem::path(RAYAUDIT_SOURCE_DIR) / "scenes/meshes/cube.obj";
+  EXPECT_NE(cull_unsafe_reason(*load_placed_mesh(cube)).find("same direction"), std::string::npos);
+  // Welding by position: the same ball with a vertex per face corner.
+  TriangleSet unshared = *ball;
+  unshared.positions.clear();
+  for (auto& t : unshared.triangles)
+    for (int& v : t.v) {
+      unshared.positions.push_back(ball->positions[v]);
+      v = int(unshared.positions.size()) - 1;
+    }
+  EXPECT_EQ(cull_unsafe_reason(unshared), "");
+}
+
+// --cull really skips back faces of a closed mesh (a ray from inside the
+// ball sees only back faces) and is not applied to an open one (the same ray
+// inside an open hemisphere-like quad pair still hits).
+TEST(Cull, SkipsBackFacesOfClosedMeshesOnly) {
+  const auto dir = temp_dir();
+  write_text(dir / "ball.obj", uv_sphere_obj(8, 12, false));
+  write_text(dir / "open.obj", "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nf 1 4 3 2\n");
+  write_text(dir / "s.json", R"({"objects": [{"mesh": "ball.obj"}, {"mesh": "open.obj", "translate": [10, 0, 0]}]})");
+  const Scene scene = load_scene(dir / "s.json");
+  RenderOptions o = opts();
+  for (bool cull : {false, true}) {
+    o.cull = cull;
+    const Tracer tr(scene, o);
+    const auto inside_ball = tr.intersect(Ray<double>{{0, 0, 0}, {0.1, 0.2, 1}});
+    EXPECT_EQ(inside_ball.has_value(), !cull);
+    // The open quad at z = -1 faces -z: seen from z = 0 it is a back face,
+    // but the mesh is open, so culling leaves it alone.
+    EXPECT_TRUE(tr.intersect(Ray<double>{{10, 0, 0}, {0, 0, -1}}).has_value()) << cull;
+  }
+}
+
+// Issue 3's check on document 004's cube: rendered with every triangle
+// method in both precisions, an image may differ from Moller-Trumbore's in
+// double (as 8-bit PNGs) only at pixels whose centre ray passes within half a pixel's
+// footprint of a triangle edge (the 12 cube edges or the 6 face diagonals).
+// Away from edges every method agrees on which face is hit and where; at
+// edges the methods' own tolerances (areas' epsilon3, angles' MINUS_ZERO) and
+// strict or inclusive bounds decide differently which of two faces, or
+// whether the cube, is hit. The one exception is areas in float, whose
+// Heron NaN bug also fires away from the edges (checked below case by case).
+// The distance is measured from the geometry, independently of any method.
+std::optional<SceneHit> tracer_hit(const Scene& scene, const RenderOptions& o, const Ray<double>& r) {
+  return Tracer(scene, o).intersect(r);
+}
+
+TEST(Doc004Cube, EveryMethodDiffersFromMollerOnlyAlongTriangleEdges) {
+  const Scene scene = load_scene(std::filesystem::path(RAYAUDIT_SOURCE_DIR) / "scenes/doc004-cube.json");
+  ASSERT_EQ(scene.objects.size(), 1u);
+  const TriangleSet& cube = *scene.objects[0].mesh;
+  ASSERT_EQ(cube.triangles.size(), 12u);
+  const Camera cam(scene.camera, scene.width, scene.height);
+  // Half a pixel at the cube's distance from the camera.
+  const double half_pixel = 0.5 * length(scene.camera.look_at - scene.camera.position) * 2 *
+                            std::tan(scene.camera.vfov * M_PI / 360) / scene.height;
+  auto distance_to_edges = [&](const Ray<double>& r) {
+    const Vec3d d = normalize(r.d);
+    double best = 1e300;
+    for (const auto& t : cube.triangles)
+      for (int e = 0; e < 3; ++e) {
+        const Vec3d p = cube.positions[t.v[e]], q = cube.positions[t.v[(e + 1) % 3]];
+        for (int s = 0; s <= 2000; ++s) {
+          const Vec3d x = p + (q - p) * (s / 2000.0);
+          best = std::min(best, length(cross(x - r.o, d)));
+        }
+      }
+    return best;
+  };
+  // The images as written to an 8-bit PNG (float-precision hit points move
+  // the shading by far less than a level).
+  auto to8 = [](float x) { return int(std::floor(std::clamp(x, 0.f, 1.f) * 255 + 0.5f)); };
+  RenderOptions o = opts();
+  o.triangle_method = "moller";
+  const Image ref = render(scene, o);
+  int differing_total = 0;
+  for (const Method& m : methods()) {
+    if (m.kind != Kind::triangle) continue;
+    for (bool dbl : {true, false}) {
+      o.triangle_method = m.name;
+      o.use_double = dbl;
+      const Image img = render(scene, o);
+      for (int j = 0; j < img.height; ++j)
+        for (int i = 0; i < img.width; ++i) {
+          const float *a = img.at(i, j), *b = ref.at(i, j);
+          if (to8(a[0]) == to8(b[0]) && to8(a[1]) == to8(b[1]) && to8(a[2]) == to8(b[2])) continue;
+          ++differing_total;
+          const Ray<double> ray = cam.ray(i + 0.5, j + 0.5);
+          if (distance_to_edges(ray) <= half_pixel) continue;
+          // Away from the edges only areas in float may differ, through the
+          // listing's Heron bug (areas.h): a plane crossing far outside a
+          // triangle accepted because a sub-area is NaN; either the camera
+          // ray takes such a false hit, or a shadow ray does (darker pixel).
+          ASSERT_TRUE(m.name == "areas" && !dbl)
+              << m.name << (dbl ? " double" : " float") << " differs away from the edges at pixel " << i << "," << j;
+          const auto h = tracer_hit(scene, o, ray), h_ref = tracer_hit(scene, opts(), ray);
+          if (h && h_ref && h->prim == h_ref->prim) {
+            for (int c = 0; c < 3; ++c) EXPECT_LT(to8(a[c]), to8(b[c])) << "pixel " << i << "," << j;
+            continue;
+          }
+          ASSERT_TRUE(h) << "pixel " << i << "," << j;
+          const auto& tri = cube.triangles[h->prim];
+          const Vec3<float> A(cube.positions[tri.v[0]]), B(cube.positions[tri.v[1]]), C(cube.positions[tri.v[2]]);
+          const Vec3<float> p = Ray<float>(ray).at(float(h->t));
+          EXPECT_TRUE(std::isnan(areas::area(p, B, C)) || std::isnan(areas::area(A, p, C)) ||
+                      std::isnan(areas::area(A, B, p)))
+              << "pixel " << i << "," << j << ": a false hit of areas/float that is not the NaN bug";
+        }
+    }
+  }
+  // The document methods with tolerances do differ somewhere (else this
+  // test would check nothing).
+  EXPECT_GT(differing_total, 0);
 }
 
 TEST(Accel, BvhLeavesHoldAtMostFourTrianglesAndEveryTriangleOnce) {

@@ -139,7 +139,7 @@ std::vector<Method> build() {
       "Cramer's rule with the text's a..l scalars; strict 0 < beta, gamma, beta+gamma < 1"));
   m.push_back(triangle_method<AreasM>(
       "areas", "seeds/001 (ray-triangle)",
-      "plane with epsilon5 < t, then Heron areas, sum <= ABC + epsilon3 (1e-3)"));
+      "plane with epsilon5 < distance, then Heron areas, sum <= ABC + epsilon3 (1e-3); a NaN area accepts"));
   m.push_back(triangle_method<TripleM>(
       "triple", "seeds/002 (Cramer, triple products)",
       "Cramer's rule via scalar triple products; inclusive 0 <= l2, l3, l2+l3 <= 1"));
@@ -148,7 +148,7 @@ std::vector<Method> build() {
       "plane with |N.v| < 1e-6 as parallel, then same side per edge with >= 0"));
   m.push_back(triangle_method<MollerM>(
       "moller", "Moller & Trumbore, JGT 1997",
-      "Moller-Trumbore: edge vectors and a determinant, no stored plane"));
+      "Moller-Trumbore: edge vectors and a determinant, no stored plane; det == 0 as parallel (the paper's EPSILON 1e-6 dropped)"));
   m.push_back(triangle_method<WatertightM>(
       "watertight", "Woop et al., JCGT 2013 + pbrt-v4 deltaT",
       "shear to ray space, 2D edge functions (double fallback), conservative t bound"));

@@ -54,6 +54,7 @@ struct PreparedMesh {
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
   double bs_radius = 0;
+  bool cull = false;  // --cull, and the mesh is closed (cull_unsafe_reason)
 };
 
 // Does the segment [tmin, tmax] of the ray pass through the solid ball?
@@ -157,6 +158,11 @@ struct Tracer::Impl {
       lo = vmin(lo, p);
       hi = vmax(hi, p);
     }
+    if (opt.cull) {
+      const std::string why = cull_unsafe_reason(set);
+      m.cull = why.empty();
+      if (!m.cull) std::fprintf(stderr, "warning: %s: --cull not applied to this mesh: %s\n", set.name.c_str(), why.c_str());
+    }
     m.bs_center = (lo + hi) * 0.5;
     for (const auto& p : set.positions) m.bs_radius = std::max(m.bs_radius, length(p - m.bs_center));
     if (opt.accel == Accel::bvh) build_bvh(m, k, lo, hi);
@@ -249,7 +255,7 @@ struct Tracer::Impl {
           const auto& k = tri_method->triangle<T>();
           if (opt.accel == Accel::bvh) {
             traverse(m.bvh, window, window.tmax, [&](std::uint32_t slot) {
-              if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, opt.cull))
+              if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
                 consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
               return false;
             });
@@ -261,7 +267,7 @@ struct Tracer::Impl {
             break;
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
-            if (auto h = k.hit_pre(window, m.pre.data() + i * m.stride, opt.cull))
+            if (auto h = k.hit_pre(window, m.pre.data() + i * m.stride, m.cull))
               consider(double(h->t), int(oi), int(i), double(h->b1), double(h->b2));
           break;
         }
@@ -289,7 +295,7 @@ struct Tracer::Impl {
           if (opt.accel == Accel::bvh) {
             bool hit = false;
             traverse(m.bvh, r, r.tmax, [&](std::uint32_t slot) {
-              return hit = k.any_pre(r, m.pre.data() + slot * m.stride, opt.cull);
+              return hit = k.any_pre(r, m.pre.data() + slot * m.stride, m.cull);
             });
             if (hit) return true;
             break;
@@ -299,7 +305,7 @@ struct Tracer::Impl {
             break;
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
-            if (k.any_pre(r, m.pre.data() + i * m.stride, opt.cull)) return true;
+            if (k.any_pre(r, m.pre.data() + i * m.stride, m.cull)) return true;
           break;
         }
       }

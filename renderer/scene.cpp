@@ -2,7 +2,10 @@
 // the JSON path) where every field has a default.
 #include "scene.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -345,6 +348,48 @@ std::vector<Vec3d> area_weighted_vertex_normals(const TriangleSet& set) {
     if (len > 0) n = n / len;
   }
   return vn;
+}
+
+std::string cull_unsafe_reason(const TriangleSet& set) {
+  // Weld: one id per distinct position (exact equality), so meshes written
+  // with a vertex per face corner still count as closed.
+  const std::size_t nv = set.positions.size();
+  std::vector<std::uint32_t> order(nv), id(nv);
+  for (std::uint32_t i = 0; i < nv; ++i) order[i] = i;
+  auto key = [&](std::uint32_t i) {
+    const Vec3d& p = set.positions[i];
+    return std::array<double, 3>{p.x, p.y, p.z};
+  };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+  std::uint32_t next = 0;
+  for (std::size_t k = 0; k < nv; ++k) {
+    if (k > 0 && key(order[k]) != key(order[k - 1])) ++next;
+    id[order[k]] = next;
+  }
+  std::vector<std::uint64_t> edges;  // directed, (from << 32) | to
+  edges.reserve(set.triangles.size() * 3);
+  for (const auto& tri : set.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint64_t u = id[tri.v[e]], v = id[tri.v[(e + 1) % 3]];
+      if (u != v) edges.push_back(u << 32 | v);
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t k = 0; k + 1 < edges.size(); ++k)
+    if (edges[k] == edges[k + 1])
+      return "two triangles run along an edge in the same direction (inconsistent winding or a non-manifold edge)";
+  for (const std::uint64_t e : edges)
+    if (!std::binary_search(edges.begin(), edges.end(), (e & 0xffffffffu) << 32 | e >> 32))
+      return "it is not closed (an edge belongs to one triangle only)";
+  if (edges.empty()) return "it has no triangles with an area";
+  // Signed volume (times 6) about the first vertex: positive when the
+  // normals point out of the enclosed solid.
+  const Vec3d o = set.positions[set.triangles[0].v[0]];
+  double volume6 = 0;
+  for (const auto& tri : set.triangles)
+    volume6 += dot(set.positions[tri.v[0]] - o,
+                   cross(set.positions[tri.v[1]] - o, set.positions[tri.v[2]] - o));
+  if (!(volume6 > 0)) return "its triangles face inward (negative signed volume)";
+  return "";
 }
 
 BoundingSphere scene_bounds(const Scene& scene) {

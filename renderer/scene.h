@@ -94,6 +94,13 @@ struct TriangleSet {
 // normalised. The renderer and the POV-Ray exporter both use this.
 std::vector<Vec3d> area_weighted_vertex_normals(const TriangleSet& set);
 
+// Document 002 culls back faces of CLOSED meshes only: on any other set a
+// back face can be the visible one. Returns why culling would change what is
+// seen, or "" for a closed surface (vertices welded by exact position; every
+// edge shared by exactly two triangles, traversed once in each direction)
+// whose (B-A)x(C-A) normals point outward (positive signed volume).
+std::string cull_unsafe_reason(const TriangleSet& set);
+
 struct Object {
   enum class Kind { sphere, plane, mesh } kind = Kind::sphere;
   SphereObject sphere;

@@ -18,7 +18,12 @@ namespace ra::areas {
 inline constexpr double epsilon5 = 1e-5;
 inline constexpr double epsilon3 = 1e-3;
 
-// Heron's formula exactly as the listing's area(v1, v2, v3).
+// Heron's formula exactly as the listing's area(v1, v2, v3). The listing's
+// bug, kept: for a point (nearly) on the line through two vertices the
+// product p(p-a)(p-b)(p-c) is zero in exact arithmetic but can round below
+// zero, and sqrt gives NaN; the listing's `sum > ABC + epsilon3` is then false,
+// so a point on an edge's extension, far outside the triangle, is accepted
+// (triangle_documents_test.cpp shows it).
 template <class T>
 T area(const Vec3<T>& v1, const Vec3<T>& v2, const Vec3<T>& v3) {
   const T a = length(v2 - v1);
@@ -38,8 +43,10 @@ std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, con
   if (cull && detail::culled(r, N)) return std::nullopt;
   const T d = -dot(N, A);
   const T t = (-d - dot(N, r.o)) / dot(N, r.d);
-  // The listing's test; a parallel ray gives +-inf or NaN here and fails it.
-  if (!(t > T(epsilon5) && t < std::numeric_limits<T>::infinity())) return std::nullopt;
+  // The listing's test on a unit direction, so epsilon5 is a distance: with
+  // our direction of any length, t |d| is that distance. A parallel ray gives
+  // +-inf or NaN here and fails it.
+  if (!(t * length(r.d) > T(epsilon5) && t < std::numeric_limits<T>::infinity())) return std::nullopt;
   if (!detail::in_window(r, t)) return std::nullopt;
   const Vec3<T> ip = r.at(t);
   const T abc = area(A, B, C);

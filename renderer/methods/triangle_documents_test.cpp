@@ -3,6 +3,7 @@
 // edges, a near-hit cut-off, a scale-dependent parallel test, a printed sign.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <optional>
 
 #include "methods/angles.h"
@@ -94,6 +95,38 @@ TYPED_TEST(DocumentMethod, AreasRejectsHitsNearerThanEpsilon5) {
   EXPECT_FALSE(hits<T>("areas", near, this->A, this->B, this->C));
   EXPECT_TRUE(hits<T>("moller", near, this->A, this->B, this->C));
   EXPECT_TRUE(hits<T>("areas", this->down(T(0.25), T(0.25), T(2e-5)), this->A, this->B, this->C));
+}
+
+// epsilon5 is a distance (the document's direction is unit): a direction of
+// length 1000 with t = 5e-6 travels 5e-3 and is kept; t = 5e-9 travels 5e-6
+// and is dropped.
+TYPED_TEST(DocumentMethod, AreasEpsilon5IsADistanceWhateverTheDirectionLength) {
+  using T = TypeParam;
+  using V = Vec3<T>;
+  const Ray<T> far_enough{V{T(0.25), T(0.25), T(5e-3)}, V{0, 0, T(-1000)}};
+  EXPECT_TRUE(hits<T>("areas", far_enough, this->A, this->B, this->C));
+  const Ray<T> too_near{V{T(0.25), T(0.25), T(5e-6)}, V{0, 0, T(-1000)}};
+  EXPECT_FALSE(hits<T>("areas", too_near, this->A, this->B, this->C));
+}
+
+// The listing's Heron bug: points on the line through B and C but beyond C
+// (P = (1 - s, s), s in (1.5, 3)) are far outside, and the area sum PBC + APC
+// + ABP = s is 1/2 + (s - 1) + ... > ABC + epsilon3 for all of them; yet where
+// rounding makes PBC's Heron product negative, sqrt gives NaN, the comparison
+// is false and the document accepts the point. Every accepted point must be
+// such a NaN case, and some exist in both precisions.
+TYPED_TEST(DocumentMethod, AreasAcceptsPointsOnAnEdgeLineWhereHeronGivesNaN) {
+  using T = TypeParam;
+  using V = Vec3<T>;
+  int accepted = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const T s = T(1.5) + T(1.5) * T(i) / T(2000);
+    const Ray<T> r = this->down(T(1) - s, s);
+    if (!hits<T>("areas", r, this->A, this->B, this->C)) continue;
+    ++accepted;
+    EXPECT_TRUE(std::isnan(areas::area(V{T(1) - s, s, 0}, this->B, this->C))) << "s = " << s;
+  }
+  EXPECT_GT(accepted, 0) << "expected the listing's NaN acceptance to show on this line";
 }
 
 // |N.v| < 1e-6 with N and v unnormalised: a triangle with legs 1e-4 has
