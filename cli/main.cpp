@@ -36,8 +36,10 @@ int main(int argc, char** argv) {
     std::cerr << e.what() << "\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "rayaudit: internal error: " << e.what() << "\n";
-    return 3;
+    // Anything else (a filesystem error, an allocation too large for this
+    // machine) is still about this input: the contract has 0, 1 and 2 only.
+    std::cerr << "rayaudit: error: " << e.what() << "\n";
+    return 2;
   }
   return 0;
 }

@@ -55,7 +55,9 @@ void write_image(const std::filesystem::path& path, const Image& img, const Imag
       if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT16, px.data()))
         throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
     }
-    out->close();
+    // close() flushes: a failure here (disk full) must not rename a
+    // truncated file into place.
+    if (!out->close()) throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
   });
 }
 
