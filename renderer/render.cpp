@@ -385,7 +385,32 @@ struct Tracer::Impl {
         break;
       }
     }
+    if (!opt.use_double) s.p_error = float_point_error(o, h, s.p);
     return s;
+  }
+
+  // In float the secondary ray starts at Vec3f(p): the error bound must be
+  // float's (gamma(n) with float's epsilon, not double's), plus the rounding
+  // of p to float, or normal-offset moves the origin by far too little.
+  Vec3d float_point_error(const Object& o, const SceneHit& h, const Vec3d& p) const {
+    using detail::gamma;
+    Vec3f e;
+    switch (o.kind) {
+      case Object::Kind::sphere:
+        e = sphere_point_error(Vec3f(p - o.sphere.center)) + abs(Vec3f(o.sphere.center)) * gamma<float>(1);
+        break;
+      case Object::Kind::plane:
+        e = abs(Vec3f(p)) * gamma<float>(7);
+        break;
+      case Object::Kind::mesh: {
+        const TriangleSet& set = *o.mesh;
+        const MeshTriangle3& tri = set.triangles[h.prim];
+        e = triangle_point_error(Vec3f(set.positions[tri.v[0]]), Vec3f(set.positions[tri.v[1]]),
+                                 Vec3f(set.positions[tri.v[2]]), float(h.b1), float(h.b2));
+        break;
+      }
+    }
+    return Vec3d(e + abs(Vec3f(p)) * gamma<float>(1));
   }
 
   // The pigment: the texture at (u, v) where the surface has UVs, else the

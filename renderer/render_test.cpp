@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "camera.h"
 #include "errors.h"
@@ -201,6 +202,7 @@ TEST(Render, SupersamplingAveragesTheSubpixelCentres) {
     }
   expect_color(tr.pixel(0, 0), sum / 4.0);
 }
+
 
 }  // namespace
 }  // namespace ra
