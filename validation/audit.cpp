@@ -528,7 +528,7 @@ std::string Report::summary_table() const {
                  : "none");
   }
   out +=
-      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = right hit, t off by > 1%; "
+      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = right hit, t off by > 1% or nearer a sphere's far root; "
       "LEAKS = edge/vertex/mesh rays the exact answer hits and the method misses entirely;\n"
       "DOUBLE = more hits than exact crossings; SELF% = spawned secondary rays re-hitting their "
       "triangle; boundary/coplanar/degenerate cases are in the JSON, never counted wrong.\n";
