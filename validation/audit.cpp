@@ -65,15 +65,14 @@ std::uint64_t ulp_bin_low(int bin) {
   const int e = (bin - 64) / 4 + 6, sub = (bin - 64) % 4;
   return (std::uint64_t(1) << e) + (std::uint64_t(sub) << (e - 2));
 }
-// Relative errors: bin 0 is exact; then 8 bins per octave from 2^-160.
-constexpr int kRelMinExp = -160;
+// Relative errors: bin 0 is exact; then 8 bins per octave from 2^kRelMinExp.
 int rel_bin(double r) {
   if (r <= 0) return 0;
-  const double l = std::log2(r);
-  const int b = 1 + int(std::floor((l - kRelMinExp) * 8));
-  return std::clamp(b, 1, Stats::kRelBins - 1);
+  const double l = std::log2(r);  // +inf for r = inf: the last bin
+  const double b = 1 + std::floor((l - Stats::kRelMinExp) * 8);
+  return int(std::clamp(b, 1.0, double(Stats::kRelBins - 1)));
 }
-double rel_bin_low(int bin) { return bin == 0 ? 0 : std::exp2(kRelMinExp + (bin - 1) / 8.0); }
+double rel_bin_low(int bin) { return bin == 0 ? 0 : std::exp2(Stats::kRelMinExp + (bin - 1) / 8.0); }
 
 template <std::size_t N> int median_bin(const std::array<std::uint64_t, N>& h, std::uint64_t n) {
   std::uint64_t acc = 0;
@@ -168,7 +167,10 @@ void book(Stats& s, const oracle::Answer& a, bool hit, bool finite, T t) {
   s.max_rel = std::max(s.max_rel, rel);
   ++s.ulp_hist[std::size_t(ulp_bin(ulps))];
   ++s.rel_hist[std::size_t(rel_bin(rel))];
-  if (rel > kWrongTRelative) ++s.wrong_t;
+  // The far root: the roots are told apart only when they differ in T.
+  const bool far_root = std::isfinite(a.t_far) && T(a.t_far) != T(a.t) &&
+                        std::abs(double(t) - a.t_far) < std::abs(double(t) - a.t);
+  if (rel > kWrongTRelative || far_root) ++s.wrong_t;
 }
 
 template <class T> Vec3<T> cv(const Vec3d& v) { return Vec3<T>(v); }
@@ -486,7 +488,7 @@ nlohmann::json Report::to_json() const {
           {"semantics",
            "ray = {o + t d : max(tmin,0) <= t <= tmax}; closed triangle; inputs exact as given "
            "(float cases rounded to float before method and oracle); wrong = false hits + false "
-           "misses + hits with relative t error > 1e-2; boundary/coplanar/degenerate answers are "
+           "misses + hits with relative t error > 1e-2 or (spheres) nearer the far root than the near one; boundary/coplanar/degenerate answers are "
            "counted apart, never wrong"},
           {"subjects", subs},
           {"cells", cs}};
@@ -526,7 +528,7 @@ std::string Report::summary_table() const {
                  : "none");
   }
   out +=
-      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = right hit, t off by > 1%; "
+      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = right hit, t off by > 1% or nearer a sphere's far root; "
       "LEAKS = edge/vertex/mesh rays the exact answer hits and the method misses entirely;\n"
       "DOUBLE = more hits than exact crossings; SELF% = spawned secondary rays re-hitting their "
       "triangle; boundary/coplanar/degenerate cases are in the JSON, never counted wrong.\n";
@@ -535,7 +537,7 @@ std::string Report::summary_table() const {
 
 std::string Report::to_csv() const {
   std::ostringstream os;
-  os << "method,precision,family,sweep,tests,wrong,false_hits,false_misses,wrong_t,boundary_hits,"
+  os << "method,precision,family,sweep,tests,wrong,true_hits,false_hits,true_misses,false_misses,wrong_t,boundary_hits,"
         "boundary_misses,coplanar_hits,coplanar_misses,degenerate_hits,degenerate_misses,nan_inf,"
         "groups,leaks,double_hits,spawned,self_hits,t_ulps_median,t_ulps_max,t_rel_median,t_rel_max\n";
   for (const Cell& c : cells) {
@@ -543,7 +545,8 @@ std::string Report::to_csv() const {
     const std::string& n = subjects[c.subject];
     const auto slash = n.rfind('/');
     os << n.substr(0, slash) << ',' << n.substr(slash + 1) << ',' << c.family << ',' << c.sweep_label
-       << ',' << s.tests << ',' << s.wrong() << ',' << s.false_hits << ',' << s.false_misses << ','
+       << ',' << s.tests << ',' << s.wrong() << ',' << s.true_hits << ',' << s.false_hits << ','
+       << s.true_misses << ',' << s.false_misses << ','
        << s.wrong_t << ',' << s.boundary_hits << ',' << s.boundary_misses << ',' << s.coplanar_hits
        << ',' << s.coplanar_misses << ',' << s.degenerate_hits << ',' << s.degenerate_misses << ','
        << s.nan_inf << ',' << s.groups << ',' << s.leaks << ',' << s.double_hits << ',' << s.spawned

@@ -78,7 +78,10 @@ struct Stats {
                 boundary_hits = 0, boundary_misses = 0, coplanar_hits = 0, coplanar_misses = 0,
                 degenerate_hits = 0, degenerate_misses = 0;
   std::uint64_t nan_inf = 0;  // a reported hit with a NaN or infinite t, b1 or b2
-  std::uint64_t wrong_t = 0;  // a right hit whose t is off by more than kWrongTRelative
+  // A right hit whose t is off by more than kWrongTRelative, or (spheres, both
+  // roots in the window and distinct in the subject's precision) whose t is
+  // closer to the far root than to the near one: the wrong root.
+  std::uint64_t wrong_t = 0;
   // Per group (edge pair, vertex fan, closed mesh): the exact answer meets
   // the group but the subject hits none of it (leak), or the subject reports
   // more hits than the ray has distinct exact crossings (double hit).
@@ -86,7 +89,11 @@ struct Stats {
   // Secondary rays: spawned, and how many hit the triangle they left.
   std::uint64_t spawned = 0, self_hits = 0;
   // t error of right hits: ulps in the subject's precision and relative.
-  static constexpr int kUlpBins = 320, kRelBins = 700;
+  // Relative errors: bin 0 is exact, then 8 bins per octave from 2^-80 to
+  // 2^64 (below 2^-80 counts in bin 1, above 2^64 in the last bin): double
+  // rounding errors are ~2^-53, float ~2^-24, a wrong root can be >> 1.
+  static constexpr int kRelMinExp = -80, kRelMaxExp = 64;
+  static constexpr int kUlpBins = 320, kRelBins = 1 + (kRelMaxExp - kRelMinExp) * 8;
   std::uint64_t t_samples = 0, max_ulps = 0;
   double max_rel = 0;
   std::array<std::uint64_t, kUlpBins> ulp_hist{};

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <stdexcept>
 
 namespace ra::audit {
@@ -55,7 +56,8 @@ const std::vector<double> kAspects = {1e1, 1e2, 1e3, 1e4, 1e5, 1e6};
 const std::vector<int> kNearMissUlps = {1, 8, 64};
 const std::vector<std::string> kDegenerate = {"collinear", "repeated-vertex", "zero-direction",
                                               "near-collinear"};
-const std::vector<double> kSecondaryScales = {1e-4, 1, 1e4, 1e8};
+// The secondary family runs over the scale family's sweep (1e-8..1e8, 4 decades per value).
+const std::vector<double>& kSecondaryScales = kScaleLo;
 const std::vector<std::string> kStrategies = {"eps", "pov", "normal-offset", "ulp-offset"};
 const std::vector<double> kHugeRadii = {1e4, 1e5, 1e6, 1e7};
 const std::vector<double> kFarDistances = {1e2, 1e4, 1e6, 1e8};
@@ -158,6 +160,28 @@ double step_ulps(double x, int dir, int ulps, Precision p) {
   return x;
 }
 
+// A grid on which every sum and difference the families form is exact in
+// the requested precision: multiples of h = 2^(E - P) with |x| < 2^E are
+// representable (P = 24 or 53), and so is the difference of two of them when
+// it stays below 2^E. Rays built as o = grid point, d = target - o (exact)
+// reach target exactly at t = 1: the exact crossing is the intended point.
+struct Grid {
+  double h;
+  explicit Grid(double bound, Precision p) {
+    const int e = std::ilogb(bound) + 1;  // 2^e > bound
+    h = std::ldexp(1.0, e - (p == Precision::f32 ? 24 : 53));
+  }
+  double snap(double x) const { return std::nearbyint(x / h) * h; }
+  Vec3d snap(const Vec3d& v) const { return {snap(v.x), snap(v.y), snap(v.z)}; }
+};
+
+// Size of the local configuration at an offset: 1, or 64 grid steps when the
+// precision cannot resolve a unit-size configuration there (float at 1e7,
+// where the spacing is 1): a unit triangle would collapse onto a few points.
+double local_scale(double offset, Precision p) {
+  return std::max(1.0, 64 * Grid(offset + 16, p).h);
+}
+
 // ---------------------------------------------------- triangle makers ---
 void add_single(TriangleBatch& b, const Tri& t, const Rayd& r) {
   b.tris.push_back(t);
@@ -197,23 +221,74 @@ void random_case(Rng& g, double spread, double scale, const Vec3d& offset, Trian
 
 Vec3d random_offset(Rng& g, double magnitude) { return g.unit() * magnitude; }
 
-// Two triangles sharing edge pq, folded by a random dihedral, and a ray aimed
-// at a float point of pq (rounded to float for both precisions).
-void edge_case(Rng& g, double offset, TriangleBatch& b) {
+// A segment from p (on the grid) of m equal grid vectors e toward a random
+// point of the cube of half-size `size` about `centre`: every p + j e is a
+// representable point exactly on the segment. Only e's with at least `min_steps`
+// grid steps in their largest component (so directions stay varied) and, when
+// `not_along` >= 0, a component off that axis.
+struct GridSegment {
+  Vec3d p, e;
+  long long m;
+  Vec3d at(long long j) const { return p + e * double(j); }
+  Vec3d q() const { return at(m); }
+};
+GridSegment grid_segment(Rng& g, const Grid& grid, const Vec3d& centre, double size, int not_along = -1) {
+  for (;;) {
+    GridSegment s;
+    s.p = grid.snap(centre + g.in_cube(size));
+    const Vec3d q0 = centre + g.in_cube(size);
+    const Vec3d span = (q0 - s.p) / grid.h;
+    const double big = std::max(std::abs(span.x), std::max(std::abs(span.y), std::abs(span.z)));
+    s.m = std::min<long long>(2 + g.below(255), (long long)(big / 8));
+    if (s.m < 2 || big < 0.3 * size / grid.h) continue;
+    const double md = double(s.m);
+    s.e = Vec3d{std::nearbyint(span.x / md), std::nearbyint(span.y / md), std::nearbyint(span.z / md)} * grid.h;
+    if (not_along >= 0) {
+      Vec3d rest = s.e;
+      rest[not_along] = 0;
+      if (rest == Vec3d{0, 0, 0}) continue;
+    }
+    return s;
+  }
+}
+// A random interior index of a segment of m steps, within [lo, hi] of it.
+long long interior_step(Rng& g, long long m, double lo, double hi) {
+  const long long a = std::max(1LL, (long long)std::ceil(lo * double(m)));
+  const long long z = std::min(m - 1, (long long)std::floor(hi * double(m)));
+  return a + (z > a ? (long long)(g.next() % std::uint64_t(z - a + 1)) : 0);
+}
+// Three aims in four are the exact point; the rest are moved up to 4 grid
+// steps per coordinate (rays just beside the edge or vertex, still exact rays).
+Vec3d maybe_jitter(Rng& g, const Grid& grid, const Vec3d& x) {
+  if (g.below(4) != 0) return x;
+  return x + Vec3d{double(g.below(9) - 4), double(g.below(9) - 4), double(g.below(9) - 4)} * grid.h;
+}
+
+// Two triangles sharing edge pq, folded by a random dihedral, and a ray
+// crossing pq exactly at a representable point of it (or, one ray in four,
+// a few grid steps beside it). Every coordinate is on a grid of the requested
+// precision (see Grid), the aim is p + j e exactly, and d = aim - o exactly.
+void edge_case(Rng& g, double offset, Precision prec, TriangleBatch& b) {
+  const double L = local_scale(offset, prec);
+  const Grid grid(offset + 16 * L, prec);
   const Vec3d off = random_offset(g, offset);
-  const Vec3d p = g.in_cube(1) + off, q = g.in_cube(1) + off;
+  const GridSegment seg = grid_segment(g, grid, off, L);
+  const Vec3d p = seg.p, q = seg.q();
   const Vec3d e = normalize(q - p);
   Vec3d u, w;
   frame(e, u, w);
   const Vec3d m = (p + q) * 0.5;
   const double h1 = g.uniform(0.3, 1.5), h2 = g.uniform(0.3, 1.5);
-  const Vec3d r1 = m + u * h1 + w * (h1 * g.uniform(-0.5, 0.5));
-  const Vec3d r2 = m - u * h2 + w * (h2 * g.uniform(-0.5, 0.5));
-  const Vec3d aim = to_float(p + (q - p) * g.uniform(0.05, 0.95));
+  const Vec3d r1 = grid.snap(m + (u * h1 + w * (h1 * g.uniform(-0.5, 0.5))) * L);
+  const Vec3d r2 = grid.snap(m - (u * h2 + w * (h2 * g.uniform(-0.5, 0.5))) * L);
+  const Vec3d aim = maybe_jitter(g, grid, seg.at(interior_step(g, seg.m, 0.05, 0.95)));
   const Tri t1{p, q, r1}, t2{q, p, r2};
   Vec3d o;
   for (int tries = 0; tries < 64; ++tries) {
-    o = aim + (w * (g.below(2) ? 1.0 : -1.0) + g.in_cube(0.7)) * g.uniform(1, 3);
+    // (one draw per statement: the order of draws must not depend on the compiler)
+    const double side = g.below(2) ? 1.0 : -1.0;
+    const Vec3d jit = g.in_cube(0.7);
+    o = grid.snap(aim + (w * side + jit) * (g.uniform(1, 3) * L));
     if (faces_alike({t1, t2}, aim - o)) break;
   }
   b.tris.push_back(t1);
@@ -222,9 +297,13 @@ void edge_case(Rng& g, double offset, TriangleBatch& b) {
 }
 
 // A closed fan of 3..8 triangles around vertex v (a shallow cone), and a ray
-// aimed at v from within 60 degrees of the cone's axis.
-void vertex_case(Rng& g, double offset, TriangleBatch& b) {
-  const Vec3d v = to_float(g.in_cube(1) + random_offset(g, offset));
+// aimed exactly at v (one in four: a few grid steps beside it) from within
+// 60 degrees of the cone's axis; on the grid as edge_case.
+void vertex_case(Rng& g, double offset, Precision prec, TriangleBatch& b) {
+  const double L = local_scale(offset, prec);
+  const Grid grid(offset + 16 * L, prec);
+  const Vec3d local = g.in_cube(1) * L;
+  const Vec3d v = grid.snap(local + random_offset(g, offset));
   const Vec3d e = g.unit();
   Vec3d u, w;
   frame(e, u, w);
@@ -232,20 +311,22 @@ void vertex_case(Rng& g, double offset, TriangleBatch& b) {
   std::vector<Vec3d> ring;
   for (int i = 0; i < k; ++i) {
     const double ang = 2 * std::numbers::pi * (i + g.uniform(-0.3, 0.3)) / k;
-    ring.push_back(v + (u * std::cos(ang) + w * std::sin(ang)) * g.uniform(0.5, 1.5) +
-                   e * g.uniform(-0.3, 0.3));
+    const double radial = g.uniform(0.5, 1.5);
+    ring.push_back(grid.snap(v + ((u * std::cos(ang) + w * std::sin(ang)) * radial + e * g.uniform(-0.3, 0.3)) * L));
   }
   const int first = int(b.tris.size());
   for (int i = 0; i < k; ++i) b.tris.push_back({v, ring[i], ring[(i + 1) % k]});
   const double side = g.below(2) ? 1.0 : -1.0;
   const std::vector<Tri> fan(b.tris.begin() + first, b.tris.end());
+  const Vec3d aim = maybe_jitter(g, grid, v);
   Vec3d o;
   for (int tries = 0; tries < 64; ++tries) {
-    const Vec3d dir = normalize(e * side + (u * g.uniform(-1, 1) + w * g.uniform(-1, 1)) * 1.7);
-    o = v + dir * g.uniform(1, 3);
-    if (faces_alike(fan, v - o)) break;
+    const double su = g.uniform(-1, 1);
+    const Vec3d dir = normalize(e * side + (u * su + w * g.uniform(-1, 1)) * 1.7);
+    o = grid.snap(v + dir * (g.uniform(1, 3) * L));
+    if (faces_alike(fan, aim - o)) break;
   }
-  b.probes.push_back({aimed(o, v), first, k});
+  b.probes.push_back({aimed(o, aim), first, k});
 }
 
 // A unit-size triangle and a ray meeting its plane at `angle` radians, aimed
@@ -276,25 +357,32 @@ void sliver_case(Rng& g, double aspect, TriangleBatch& b) {
   add_single(b, {a, bb, c}, aimed(o, aim));
 }
 
-// A point of an edge stepped `ulps` ulps (of the precision) outward from the
-// triangle in every coordinate, and a ray aimed at it.
+// A triangle whose plane contains the axis direction x_k, an exact grid point
+// X of one of its edges, and Y = X stepped `ulps` ulps (of the precision) along
+// x_k away from the opposite vertex: Y lies in the plane, outside the edge, and
+// is representable. The ray has d_k = 0 and o = Y - d (exact), so it crosses
+// the plane exactly at Y: an exact miss by construction (checked by a test).
 void near_miss_case(Rng& g, int ulps, Precision p, TriangleBatch& b) {
-  Tri t{g.in_cube(1), g.in_cube(1), g.in_cube(1)};
-  if (p == Precision::f32) t = {to_float(t.a), to_float(t.b), to_float(t.c)};
+  const Grid grid(16, p);
   const int k = g.below(3);
-  const Vec3d& P0 = k == 0 ? t.a : k == 1 ? t.b : t.c;
-  const Vec3d& P1 = k == 0 ? t.b : k == 1 ? t.c : t.a;
-  const Vec3d& opp = k == 0 ? t.c : k == 1 ? t.a : t.b;
-  const Vec3d n = cross(t.b - t.a, t.c - t.a);
-  Vec3d out = cross(P1 - P0, n);  // in-plane, perpendicular to the edge
-  if (dot(out, opp - P0) > 0) out = -out;
-  Vec3d aim = P0 + (P1 - P0) * g.uniform(0.1, 0.9);
-  if (p == Precision::f32) aim = to_float(aim);
-  for (int i = 0; i < 3; ++i)
-    if (out[i] != 0) aim[i] = step_ulps(aim[i], out[i] > 0 ? 1 : -1, ulps, p);
-  const Vec3d nn = normalize(n) * (g.below(2) ? 1.0 : -1.0);
-  const Vec3d o = aim + (nn + g.in_cube(0.7)) * g.uniform(0.5, 2);
-  add_single(b, t, aimed(o, aim));
+  Vec3d ek{0, 0, 0};
+  ek[k] = 1;
+  const GridSegment seg = grid_segment(g, grid, {0, 0, 0}, 1, k);
+  const Vec3d X = seg.at(interior_step(g, seg.m, 0.1, 0.9));
+  const double sigma = g.below(2) ? 1.0 : -1.0;  // Y is on the +sigma x_k side
+  // The opposite vertex: on the edge's line shifted by -sigma c x_k, so the
+  // plane is spanned by e and x_k and the vertex is on the other side.
+  const long long jo = (long long)(g.next() % std::uint64_t(seg.m + 1));
+  const Vec3d opp = seg.at(jo) - ek * (sigma * grid.snap(g.uniform(0.3, 1.5)));
+  Vec3d Y = X;
+  Y[k] = step_ulps(X[k], sigma > 0 ? 1 : -1, ulps, p);
+  const Vec3d n = normalize(cross(seg.e, ek)) * (g.below(2) ? 1.0 : -1.0);
+  Vec3d noise = g.in_cube(0.5);
+  noise[k] = 0;
+  Vec3d d = grid.snap((n + noise) * g.uniform(0.5, 2));
+  d[k] = 0;
+  const Vec3d o = Y - d;
+  add_single(b, {seg.p, seg.q(), opp}, {o, d});
 }
 
 // Zero-area triangles built exactly (coordinates on a 1/16 grid, so sums
@@ -319,40 +407,53 @@ void degenerate_case(Rng& g, int kind, TriangleBatch& b) {
 }
 
 // Rays from inside a closed mesh (shape 0: sphere, 1: box), placed at the
-// origin or at Embree's placement: a third aimed at a vertex, a third at a
-// float point of an edge, a third in a random direction.
+// origin or at Embree's placement: a third aimed exactly at a vertex, a third
+// exactly at a representable point of an edge (one aim in four of those two
+// moved a few grid steps), a third in a random direction. The mesh vertices
+// are snapped to a grid of step H = max(4 h, 2^-10) (h: the precision's grid
+// there, see Grid), so every edge holds representable points V1 + j (V2 - V1) / g,
+// g >= 4; o is on the h grid and d = target - o is exact.
 void closed_mesh_cases(Rng& g, int sweep, Precision p, int count, TriangleBatch& b) {
   const int shape = sweep / 2;
   const Vec3d place = (sweep % 2) ? kEmbreePlacement : Vec3d{0, 0, 0};
   const Mesh& m = closed_mesh(shape);
+  const Grid grid(std::max(std::abs(place.x), std::max(std::abs(place.y), std::abs(place.z))) + 8, p);
+  const double H = std::max(4 * grid.h, 0x1p-10);
+  std::vector<Vec3d> v;
+  for (const Vec3d& x : m.v)
+    v.push_back(place + Vec3d{std::nearbyint(x.x / H), std::nearbyint(x.y / H), std::nearbyint(x.z / H)} * H);
   const int first = int(b.tris.size());
-  for (const auto& f : m.f) b.tris.push_back({m.v[f[0]] + place, m.v[f[1]] + place, m.v[f[2]] + place});
+  for (const auto& f : m.f) b.tris.push_back({v[f[0]], v[f[1]], v[f[2]]});
   const double inner = shape == 0 ? 1.2 : 0.8;  // well inside either shape
   for (int i = 0; i < count; ++i) {
     Vec3d o = g.in_cube(1);
     if (shape == 0 && dot(o, o) > 1) o = o / std::sqrt(dot(o, o));
-    o = o * inner + place;
-    Vec3d target;
+    o = grid.snap(o * inner + place);
+    Rayd r;
     const int mode = g.below(3);
     if (mode == 0) {
-      target = m.v[g.below(int(m.v.size()))] + place;
+      r = aimed(o, maybe_jitter(g, grid, v[std::size_t(g.below(int(v.size())))]));
     } else if (mode == 1) {
-      const auto& f = m.f[g.below(int(m.f.size()))];
+      const auto& f = m.f[std::size_t(g.below(int(m.f.size())))];
       const int k = g.below(3);
-      target = to_float(m.v[f[k]] + place + (m.v[f[(k + 1) % 3]] - m.v[f[k]]) * g.uniform(0.05, 0.95));
+      const Vec3d v1 = v[std::size_t(f[std::size_t(k)])], v2 = v[std::size_t(f[std::size_t((k + 1) % 3)])];
+      const Vec3d D = (v2 - v1) / grid.h;  // integers
+      const long long dx = (long long)D.x, dy = (long long)D.y, dz = (long long)D.z;
+      const long long gg = std::gcd(std::gcd(std::llabs(dx), std::llabs(dy)), std::llabs(dz));
+      const Vec3d step = Vec3d{double(dx / gg), double(dy / gg), double(dz / gg)} * grid.h;
+      r = aimed(o, maybe_jitter(g, grid, v1 + step * double(interior_step(g, gg, 0.05, 0.95))));
     } else {
-      target = o + g.unit();
+      r = {o, g.unit()};
     }
-    b.probes.push_back({aimed(o, target), first, int(m.f.size()), true});
+    b.probes.push_back({r, first, int(m.f.size()), true});
   }
-  (void)p;
 }
 
 // Secondary: a triangle at the sweep's scale and a primary ray aimed strictly
 // inside it (barycentrics >= 0.1); the engine spawns from each method's hit.
 void secondary_case(Rng& g, int sweep, TriangleBatch& b) {
   const double lo = kSecondaryScales[std::size_t(sweep) % kSecondaryScales.size()];
-  const double s = g.log_uniform(lo, lo * 10);
+  const double s = g.log_uniform(lo, lo * 1e4);
   const Tri t{g.in_cube(1) * s, g.in_cube(1) * s, g.in_cube(1) * s};
   const double b1 = g.uniform(0.1, 0.8), b2 = g.uniform(0.1, 0.9 - b1);
   const Vec3d aim = t.a + (t.b - t.a) * b1 + (t.c - t.a) * b2;
@@ -434,8 +535,8 @@ void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int
   } else {
     for (int i = 0; i < count; ++i) {
       if (f.name == "random") random_case(g, std::stod(f.sweep[s]), 1, {}, out);
-      else if (f.name == "edge") edge_case(g, kOffsets[s], out);
-      else if (f.name == "vertex") vertex_case(g, kOffsets[s], out);
+      else if (f.name == "edge") edge_case(g, kOffsets[s], p, out);
+      else if (f.name == "vertex") vertex_case(g, kOffsets[s], p, out);
       else if (f.name == "grazing") grazing_case(g, kAngles[s], out);
       else if (f.name == "offset") random_case(g, 1, 1, random_offset(g, kOffsetFamily[s]), out);
       else if (f.name == "scale") random_case(g, 1, g.log_uniform(kScaleLo[s], kScaleLo[s] * 1e4), {}, out);
