@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace ra::oracle {
@@ -121,6 +122,265 @@ Filtered filtered_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const 
   const int zeros = (w[0] == 0) + (w[1] == 0) + (w[2] == 0);
   out = make(zeros ? Verdict::boundary : Verdict::hit, kNaN, zeros);
   return Filtered::crossing;
+}
+
+// ------------------------------------------------------- double-double ---
+// A second filter between the intervals and GMP. Every quantity is evaluated
+// in double-double (about 106 bits) next to a rigorous bound on its error of
+// the form K u^2 P, where P is the polynomial's permanent (the same expression
+// over absolute values) and u = 2^-53. Each double-double add or multiply
+// commits an error of at most 4 u^2 times the sum of its operands'
+// magnitudes (Dekker; Joldes, Muller and Popescu 2017), and the inputs'
+// differences are exact (two_sum), so a degree-3 triangle quantity errs by
+// less than 24 u^2 P and a degree-4 sphere quantity by less than 64 u^2 P;
+// the constants below take 8 times that. Signs are certain when the value
+// exceeds its bound, and t is certain when its enclosure stays clear of the
+// midpoints between doubles, so rounding to nearest is decided exactly.
+// Range guard: every input is a multiple of 2^E and below 2^M; with
+// deg * E >= -960 and deg * (M + 3) <= 960 no partial result underflows or
+// overflows, so the u^2 analysis holds. Anything else goes to GMP.
+struct DD {
+  double h = 0, l = 0;
+};
+inline double fma_(double a, double b, double c) {
+#ifdef __FMA__
+  return __builtin_fma(a, b, c);
+#else
+  return std::fma(a, b, c);
+#endif
+}
+inline DD two_sum(double a, double b) {
+  const double s = a + b, bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+inline DD two_prod(double a, double b) {
+  const double p = a * b;
+  return {p, fma_(a, b, -p)};
+}
+inline DD operator+(DD x, DD y) {
+  const DD s = two_sum(x.h, y.h);
+  return two_sum(s.h, s.l + (x.l + y.l));
+}
+inline DD operator-(DD x) { return {-x.h, -x.l}; }
+inline DD operator-(DD x, DD y) { return x + (-y); }
+inline DD operator*(DD x, DD y) {
+  const DD p = two_prod(x.h, y.h);
+  return two_sum(p.h, p.l + (x.h * y.l + x.l * y.h));
+}
+inline DD operator*(DD x, double y) {
+  const DD p = two_prod(x.h, y);
+  return two_sum(p.h, p.l + x.l * y);
+}
+struct DV {
+  DD x, y, z;
+};
+inline DV dsub(const Vec3d& p, const Vec3d& q) { return {two_sum(p.x, -q.x), two_sum(p.y, -q.y), two_sum(p.z, -q.z)}; }
+inline DV dcross(const DV& a, const DV& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline DD ddot(const DV& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline DD ddot(const DV& a, const DV& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+// Magnitude bounds (permanents), computed in double and slightly inflated.
+inline Vec3d vabs(const DV& v) { return {std::abs(v.x.h), std::abs(v.y.h), std::abs(v.z.h)}; }
+inline Vec3d vabs(const Vec3d& v) { return {std::abs(v.x), std::abs(v.y), std::abs(v.z)}; }
+inline Vec3d pcross(const Vec3d& a, const Vec3d& b) {
+  return {a.y * b.z + a.z * b.y, a.z * b.x + a.x * b.z, a.x * b.y + a.y * b.x};
+}
+inline double pdot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+constexpr double kU2 = 0x1p-106;
+constexpr double kTriK = 256 * kU2;     // degree 3 (8 x 24 u^2, rounded up), see above
+constexpr double kSphK = 512 * kU2;     // degree 4 (8 x 64 u^2)
+constexpr double kInflate = 1 + 0x1p-40;  // covers rounding in the permanents
+
+// sign of v when |v| > err, else 2 (undecided).
+inline int dsign(DD v, double err) {
+  if (v.h > err) return 1;
+  if (v.h < -err) return -1;
+  return 2;
+}
+
+// Lowest set bit's exponent (x == m 2^e, m odd), and a bound on the exponent
+// of |x| (|x| < 2^top); zero is ignored.
+inline void range(double x, int& lo, int& hi) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const int ex = int((bits >> 52) & 0x7ff);
+  std::uint64_t mant = bits & ((std::uint64_t(1) << 52) - 1);
+  if (ex == 0 && mant == 0) return;
+  if (ex != 0) mant |= std::uint64_t(1) << 52;
+  const int base = (ex == 0 ? 1 : ex) - 1075;
+  lo = std::min(lo, base + __builtin_ctzll(mant));
+  hi = std::max(hi, ex - 1022);
+}
+inline bool in_range(std::initializer_list<double> xs, int deg) {
+  int lo = 10000, hi = -10000;
+  for (double x : xs) range(x, lo, hi);
+  if (lo == 10000) return true;  // all zero
+  return deg * lo >= -960 && deg * (hi + 3) <= 960;
+}
+
+// The double nearest to a value v known only as t (double-double, finite,
+// normalised so t.h = round(t.h + t.l)) within absolute error err: true and
+// sets out when every value in [t - err, t + err] rounds to the same double.
+inline bool certified_round(DD t, double err, double& out) {
+  const double h = t.h;
+  if (!std::isfinite(h) || !(err >= 0) || std::abs(h) < 0x1p-960 || std::abs(h) > 0x1p960) return false;
+  const double up = std::nextafter(h, HUGE_VAL) - h, down = h - std::nextafter(h, -HUGE_VAL);
+  // v - h is within t.l +- err; it must stay strictly inside (-down/2, up/2).
+  // (the slack on the right covers the rounding of t.l +- err)
+  constexpr double kSlack = 1 - 0x1p-40;
+  if (t.l + err >= 0.5 * up * kSlack || t.l - err <= -0.5 * down * kSlack) return false;
+  out = h;
+  return true;
+}
+
+// q = n / d in double-double with relative error below 8 u^2 (d.h != 0).
+inline DD ddiv(DD n, DD d) {
+  const double q1 = n.h / d.h;
+  const DD p = d * q1;
+  const DD r = n - p;
+  const double q2 = r.h / d.h;
+  const DD q = two_sum(q1, q2);
+  const DD p2 = d * q.h;
+  const DD r2 = n - p2;
+  return two_sum(q.h, r2.h / d.h);
+}
+
+// t = N / D rounded to nearest, from N and D within eN and eD: the relative
+// error of the quotient is at most eN/|N| + eD/|D| + 8 u^2 to first order
+// (both ratios are kept below 2^-20 so the second-order terms fit the margin).
+bool dd_t(DD N, DD D, double eN, double eD, double& t_out) {
+  if (!(std::abs(N.h) > 0x1p20 * eN)) return false;  // t near 0 (or exactly 0)
+  if (!(std::abs(D.h) > 0x1p20 * eD)) return false;
+  const double rel = (eN / std::abs(N.h) + eD / std::abs(D.h)) * 1.01 + 16 * kU2;
+  const DD t = ddiv(N, D);
+  return certified_round(t, rel * std::abs(t.h), t_out);
+}
+
+// The triangle query decided with double-double when it can be: true and out
+// filled (verdict and t exactly as the exact path gives them); false when some
+// sign or the rounding of t is too close to call.
+// With t_only, the verdict in `out` is already certain (a crossing) and only t
+// is computed.
+bool dd_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c, double lo, Answer& out,
+                 bool t_only = false) {
+  if (!in_range({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z}, 3))
+    return false;
+  const DV e1 = dsub(b, a), e2 = dsub(c, a);
+  const DV n = dcross(e1, e2);
+  const Vec3d pn = pcross(vabs(e1), vabs(e2)) * kInflate;
+  if (dsign(n.x, kTriK * pn.x) == 2 && dsign(n.y, kTriK * pn.y) == 2 && dsign(n.z, kTriK * pn.z) == 2)
+    return false;  // maybe degenerate
+  const DV ao = dsub(a, r.o), bo = dsub(b, r.o), co = dsub(c, r.o);
+  const Vec3d ad = vabs(r.d), aao = vabs(ao), abo = vabs(bo), aco = vabs(co);
+  const DD D = ddot(n, r.d), N = ddot(n, ao);
+  const double eD = kTriK * pdot(pn, ad) * kInflate, eN = kTriK * pdot(pn, aao) * kInflate;
+  const int sD = dsign(D, eD);
+  if (sD == 2) return false;  // maybe parallel
+  if (t_only) return dd_t(N, D, eN, eD, out.t);
+  const double ew[3] = {kTriK * pdot(ad, pcross(aao, abo)) * kInflate,
+                        kTriK * pdot(ad, pcross(abo, aco)) * kInflate,
+                        kTriK * pdot(ad, pcross(aco, aao)) * kInflate};
+  // An exact zero: when d == P - o exactly for a vertex P (a ray aimed at a
+  // vertex whose subtraction was exact), the two edge functions through P are
+  // determinants with two equal rows, so exactly 0.
+  bool zero[3] = {false, false, false};
+  auto is_d = [&](const DV& po) {
+    return po.x.l == 0 && po.y.l == 0 && po.z.l == 0 && po.x.h == r.d.x && po.y.h == r.d.y && po.z.h == r.d.z;
+  };
+  if (is_d(ao)) zero[0] = zero[2] = true;
+  if (is_d(bo)) zero[0] = zero[1] = true;
+  if (is_d(co)) zero[1] = zero[2] = true;
+  const int w[3] = {zero[0] ? 0 : dsign(ddot(dcross(ao, bo), r.d), ew[0]),
+                    zero[1] ? 0 : dsign(ddot(dcross(bo, co), r.d), ew[1]),
+                    zero[2] ? 0 : dsign(ddot(dcross(co, ao), r.d), ew[2])};
+  for (int s : w)
+    if (s == -sD) return out = make(Verdict::miss), true;
+  for (int s : w)
+    if (s == 2) return false;  // maybe on an edge
+  const int zeros = (w[0] == 0) + (w[1] == 0) + (w[2] == 0);
+  // The window: sign(N - x D) for x = lo and x = tmax.
+  auto side = [&](double x) {
+    if (std::abs(x) > 0x1p200) return 2;
+    const DD v = N - D * x;
+    const double err = (eN + std::abs(x) * eD) * 1.5 + 0x1p-1000;
+    if (!std::isfinite(v.h) || !std::isfinite(err)) return 2;
+    return dsign(v, err);
+  };
+  const int below = side(lo);
+  if (below == 2) return false;
+  if (below * sD < 0) return out = make(Verdict::miss), true;
+  if (std::isfinite(r.tmax)) {
+    const int above = side(r.tmax);
+    if (above == 2) return false;
+    if (above * sD > 0) return out = make(Verdict::miss), true;
+  }
+  double td;
+  if (!dd_t(N, D, eN, eD, td)) return false;
+  out = make(zeros ? Verdict::boundary : Verdict::hit, td, zeros);
+  return true;
+}
+
+// sign(t - x) for a value known as t within err, or 2.
+inline int cmp_enclosed(DD t, double err, double x) {
+  const DD d = two_sum(t.h, -x) + DD{t.l, 0};
+  if (!std::isfinite(d.h)) return 2;
+  return dsign(d, err * kInflate + 0x1p-1060);
+}
+
+// The sphere query decided with double-double when it can be (see
+// dd_triangle); tangent rays, roots on the window's ends and t too close to a
+// rounding midpoint are left to the exact path.
+bool dd_sphere(const Rayd& r, const Vec3d& center, double radius, double lo, double hi, Answer& out) {
+  if (!in_range({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, center.x, center.y, center.z, radius}, 4))
+    return false;
+  const DV f = dsub(r.o, center);
+  const Vec3d af = vabs(f), ad = vabs(r.d);
+  const DD A = two_prod(r.d.x, r.d.x) + two_prod(r.d.y, r.d.y) + two_prod(r.d.z, r.d.z);
+  const DD B = ddot(f, r.d);
+  const DD C = ddot(f, f) - two_prod(radius, radius);
+  const double pA = pdot(ad, ad) * kInflate, pB = pdot(af, ad) * kInflate,
+               pC = (pdot(af, af) + radius * radius) * kInflate;
+  const double eA = kTriK * pA, eB = kTriK * pB, eC = kTriK * pC;
+  const DD disc = B * B - A * C;
+  const double edisc = kSphK * (pB * pB + pA * pC) * kInflate;
+  const int sdisc = dsign(disc, edisc);
+  if (sdisc == 2) return false;  // maybe tangent
+  if (sdisc < 0) return out = make(Verdict::miss), true;
+  // S = sqrt(disc): one Newton step from the double root.
+  const double s1 = std::sqrt(disc.h);
+  const DD S = two_sum(s1, (disc - two_prod(s1, s1)).h / (2 * s1));
+  const double eS = edisc / std::sqrt(disc.h - edisc) * 1.01 + 16 * kU2 * s1;
+  // q = -(B + sign(B) S): no cancellation; the roots are q / A and C / q.
+  const DD q = B.h < 0 ? S - B : -(B + S);
+  const double eq = (eB + eS) * kInflate + 8 * kU2 * (std::abs(B.h) + s1);
+  if (!(std::abs(q.h) > 0x1p20 * eq) || !(A.h > 0x1p20 * eA) || !(std::abs(C.h) > 0x1p20 * eC))
+    return false;  // a root near 0 (or a bound too loose for the first-order sum)
+  const double relq = eq / std::abs(q.h), relA = eA / A.h, relC = eC / std::abs(C.h);
+  DD r1 = ddiv(q, A), r2 = ddiv(C, q);
+  double e1 = ((relq + relA) * 1.01 + 16 * kU2) * std::abs(r1.h);
+  double e2 = ((relC + relq) * 1.01 + 16 * kU2) * std::abs(r2.h);
+  if (!std::isfinite(r1.h) || !std::isfinite(r2.h)) return false;
+  if (r2.h < r1.h) std::swap(r1, r2), std::swap(e1, e2);
+  if (r1.h + e1 >= r2.h - e2) return false;  // enclosures overlap
+  auto in_window = [&](DD t, double e) {
+    const int a = cmp_enclosed(t, e, lo);
+    if (a == 2) return 2;
+    if (a < 0) return 0;
+    if (!std::isfinite(hi)) return 1;
+    const int b = cmp_enclosed(t, e, hi);
+    return b == 2 ? 2 : int(b <= 0);
+  };
+  const int near_in = in_window(r1, e1), far_in = in_window(r2, e2);
+  if (near_in == 2 || far_in == 2) return false;
+  if (!near_in && !far_in) return out = make(Verdict::miss), true;
+  double t_near = kNaN, t_far = kNaN;
+  if (near_in && !certified_round(r1, e1, t_near)) return false;
+  if (far_in && !certified_round(r2, e2, t_far)) return false;
+  out = make(Verdict::hit, near_in ? t_near : t_far);
+  if (near_in && far_in) out.t_far = t_far;
+  return true;
 }
 
 // ----------------------------------------------------------------- exact ---
@@ -285,9 +545,14 @@ Answer triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   Answer out;
   switch (filtered_triangle(r, a, b, c, lo, out)) {
     case Filtered::decided: return out;
-    case Filtered::crossing: out.t = exact_t(r, a, b, c); return out;
+    case Filtered::crossing:
+      if (dd_triangle(r, a, b, c, lo, out, /*t_only=*/true)) return out;
+      ++g_fallbacks;
+      out.t = exact_t(r, a, b, c);
+      return out;
     case Filtered::undecided: break;
   }
+  if (dd_triangle(r, a, b, c, lo, out)) return out;
   return exact_triangle(r, a, b, c, lo);
 }
 
@@ -363,6 +628,10 @@ Answer sphere(const Rayd& r, const Vec3d& center, double radius) {
     const IV f = isub(r.o, center), d = iv(r.d);
     const I A = idot(d, d), B = idot(f, d), C = idot(f, f) - I(radius) * I(radius);
     if ((B * B - A * C).sup() < 0) return make(Verdict::miss);
+  }
+  {
+    Answer out;
+    if (dd_sphere(r, center, radius, lo, hi, out)) return out;
   }
   ++g_fallbacks;
   Scratch& sc = scratch();
