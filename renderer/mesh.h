@@ -6,8 +6,13 @@
 // - Text: UTF-8 or ASCII, an optional UTF-8 BOM, LF or CRLF line ends (a lone
 //   CR is whitespace, not a line end), no trailing newline, tabs and runs of
 //   spaces, `\` immediately before the line end joins the next line, `#`
-//   after whitespace (or right after a number) starts a comment. UTF-16
-//   (BOM FF FE / FE FF) and files with NUL bytes are rejected, not decoded.
+//   after whitespace (or right after a number) starts a comment. A comment
+//   ends at its line end: a physical line holding a `#` is never continued
+//   (`v 0 0 0 # note \` does not swallow the next line). UTF-16 (BOM FF FE /
+//   FE FF) and files with NUL bytes are rejected, not decoded; so are files
+//   with CR-only line ends (classic Mac OS; found on the first line), with
+//   a message naming them: converting is the user's one-line fix, reading
+//   them would need every line scanner to know CR as a line end.
 // - Numbers: what std::from_chars accepts plus a leading `+`: `1e2`, `-.5`,
 //   `+3.E-1`, `.8e-001`. Non-finite values (`nan`, `inf`, `infinity`, MSVC's
 //   `1.#IND`, `1.#INF`, `1.#QNAN`) are errors: a grader's geometry must be
@@ -21,7 +26,8 @@
 //   vn) present on only some corners is dropped for the whole face, with one
 //   warning per file. Polygons of any size are split by ear clipping
 //   (triangulate.h) into n-2 triangles. No forward references: an index must
-//   name an element defined before the face (error at the face's line).
+//   name an element defined before the face (error at the face's line, which
+//   says either the later line defining it or how many the whole file has).
 // - `vp`, `l`, `p` are counted in `skipped` and otherwise ignored; `s`, `mg`
 //   and the free-form geometry statements (`curv`, `surf`, ...) are ignored,
 //   unknown statements get one warning per keyword.

@@ -652,9 +652,7 @@ struct ChunkParser {
       w.fail(line, std::string("malformed ") + kind + " index '" + token_text(tok, se) + "'");
     if (i == 0) w.fail(line, std::string(kind) + " index 0 (OBJ indices start at 1)");
     if (i > 0) {
-      if (i > count)
-        w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is past the end (" +
-                         std::to_string(count) + " defined before this face)");
+      if (i > count) past_the_end(kind, i, count, se, line);
       out = int(i - 1);
     } else {
       if (-i > count)
@@ -663,6 +661,34 @@ struct ChunkParser {
       out = int(count + i);
     }
     return q;
+  }
+
+  // An index past the elements defined before the face (at line `line`,
+  // ending at se): a forward reference (defined later: say at which line) or
+  // one the whole file never defines (say how many it has). Cold: scans the
+  // rest of the text (serially that is the file's end; in parallel the
+  // message is discarded, the serial re-run reports).
+  [[noreturn]] void past_the_end(const char* kind, long long i, long count, const char* se, long line) {
+    const Kw want = kind[0] == 'v' ? Kw::V : kind[0] == 't' ? Kw::VT : Kw::VN;
+    long n = count;
+    long ln = line + long(std::count(here, se, '\n')) + 1;  // line of the next statement
+    const char* p = se + (se < c.end);
+    while (p < c.end) {
+      long extra = 0;
+      const char* e = statement_end(p, c.end, extra);
+      const char* s = p;
+      const char* kend = nullptr;
+      if (read_keyword(s, e, &kend) == want && ++n == i)
+        w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is defined later, at line " +
+                         std::to_string(ln) + ": forward references are not allowed (" + std::to_string(count) +
+                         " defined before this face)");
+      ln += extra + 1;
+      p = e + 1;
+    }
+    const char* plural = kind[0] == 'v' ? " vertices" : kind[0] == 't' ? " texture coordinates" : " normals";
+    const char* single = kind[0] == 'v' ? " vertex" : kind[0] == 't' ? " texture coordinate" : " normal";
+    w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is past the end: the file has only " +
+                     std::to_string(n) + (n == 1 ? single : plural));
   }
 
   void parse_f(const char* p, const char* se, long line) {

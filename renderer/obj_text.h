@@ -1,7 +1,8 @@
 // Small scanning helpers shared by the OBJ and MTL parsers (fast_obj style:
 // each takes a pointer into one buffer and returns the pointer after what it
 // read; nothing allocates). A "statement" is one logical line: physical lines
-// joined by a `\` right before their end (LF or CRLF).
+// joined by a `\` right before their end (LF or CRLF), unless the line holds
+// a `#` (a comment ends at its line end).
 #pragma once
 #include <bit>
 #include <charconv>
@@ -19,10 +20,17 @@ namespace ra::objtext {
 inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 // True if the line break at `nl` (pointing at '\n') is escaped by `\`.
+// `begin` is at or before the start of nl's physical line. A comment ends at
+// its line end: a physical line holding a `#` anywhere is never continued
+// (`v 0 0 0 # note \` must not swallow the next line). The scan back over
+// the line runs only when a `\` is right before the line end (rare).
 inline bool escaped_newline(const char* begin, const char* nl) {
   const char* q = nl;
   if (q > begin && q[-1] == '\r') --q;
-  return q > begin && q[-1] == '\\';
+  if (!(q > begin && q[-1] == '\\')) return false;
+  for (const char* s = q - 1; s > begin && s[-1] != '\n'; --s)
+    if (s[-1] == '#') return false;
+  return true;
 }
 
 // End of the statement starting at p: the '\n' ending it (or end). Adds to
@@ -264,6 +272,21 @@ inline std::string_view check_encoding(std::string_view text, const std::string&
   if (text.size() >= 3 && (unsigned char)text[0] == 0xEF && (unsigned char)text[1] == 0xBB &&
       (unsigned char)text[2] == 0xBF)
     text.remove_prefix(3);
+  // CR-only line ends (classic Mac OS) are not read as line breaks (a lone CR
+  // is whitespace, so the whole file would be one statement): say so rather
+  // than report the first symptom ("malformed number 'v'"). Detected on the
+  // first line: a CR followed by anything but whitespace before any LF.
+  {
+    const char* b = text.data();
+    const void* lf = std::memchr(b, '\n', text.size());
+    const char* lim = lf ? static_cast<const char*>(lf) : b + text.size();
+    for (const char* c = b; (c = static_cast<const char*>(std::memchr(c, '\r', size_t(lim - c)))) != nullptr;) {
+      ++c;
+      if (c < lim && !is_space(*c))
+        throw InputError(located(name, 1, "the file uses CR-only line ends (classic Mac OS), which are not "
+                                          "supported: convert them to LF or CRLF"));
+    }
+  }
   if (const void* z = std::memchr(text.data(), 0, text.size())) {
     const char* zp = static_cast<const char*>(z);
     long line = 1;
