@@ -16,11 +16,21 @@ struct Args {
   bool skip_unavailable = false;
 };
 
-// "sphere-on-plane", "scenes/sphere-on-plane.json" -> "sphere-on-plane".
+// A scene's name is its path under scenes/ without ".json":
+// "sphere-on-plane", "scenes/sphere-on-plane.json" -> "sphere-on-plane";
+// "corpus/ladder-10-box", "scenes/corpus/ladder-10-box.json" -> "corpus/ladder-10-box".
+// Any other path (e.g. absolute) names the scene by its stem, as before.
 std::vector<std::string> names_of(const std::vector<std::string>& given, const ra::GoldenSet& set) {
   if (given.empty()) return set.all_names();
   std::vector<std::string> out;
-  for (const auto& g : given) out.push_back(std::filesystem::path(g).stem().string());
+  for (const auto& g : given) {
+    std::filesystem::path p = std::filesystem::path(g).lexically_normal();
+    if (p.extension() == ".json") p.replace_extension();
+    std::string rel = p.generic_string();
+    if (rel.rfind("scenes/", 0) == 0) rel = rel.substr(7);
+    const bool plain = !p.is_absolute() && rel.find("..") == std::string::npos;
+    out.push_back(plain ? rel : p.filename().string());
+  }
   return out;
 }
 

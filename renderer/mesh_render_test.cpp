@@ -2,6 +2,7 @@
 // analytic sphere, texture lookups at known UVs, bump variants that must not
 // change a flat surface, culling and the three accelerations changing
 // nothing, the MTL -> finish mapping, and mesh placement.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -163,6 +164,51 @@ TEST(SmoothNormals, AreaWeightedNormalsStayWithinTheDerivedBound) {
   EXPECT_LT(worst, rho);
 }
 
+// Area weighting worked by hand. Vertex 0 is shared by
+//   T1 = (0,0,0), (1,0,0), (0,1,0): (B-A)x(C-A) = (0,0,1), area 1/2, and
+//   T2 = (0,0,0), (0,4,0), (0,0,5): (0,4,0)x(0,0,5) = (20,0,0), area 10,
+// so its area-weighted normal is (20,0,1)/sqrt(401), about 2.9 degrees from
+// +x; an unweighted mean of the unit face normals would be (1,0,1)/sqrt(2),
+// 45 degrees away. The other vertices belong to one triangle each.
+TEST(SmoothNormals, VertexNormalsAreWeightedByTriangleArea) {
+  auto set = std::make_shared<TriangleSet>();
+  set->positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 4, 0}, {0, 0, 5}};
+  MeshTriangle3 t1, t2;
+  t1.v = {0, 1, 2};
+  t2.v = {0, 3, 4};
+  set->triangles = {t1, t2};
+  set->materials.resize(1);
+  set->materials[0].ambient = {0, 0, 0};
+  set->shading = Shading::smooth;
+  const std::vector<Vec3d> vn = area_weighted_vertex_normals(*set);
+  ASSERT_EQ(vn.size(), 5u);
+  const double r401 = std::sqrt(401.0);
+  EXPECT_NEAR(vn[0].x, 20 / r401, 1e-15);
+  EXPECT_EQ(vn[0].y, 0);
+  EXPECT_NEAR(vn[0].z, 1 / r401, 1e-15);
+  EXPECT_EQ(vn[1], (Vec3d{0, 0, 1}));
+  EXPECT_EQ(vn[2], (Vec3d{0, 0, 1}));
+  EXPECT_EQ(vn[3], (Vec3d{1, 0, 0}));
+  EXPECT_EQ(vn[4], (Vec3d{1, 0, 0}));
+
+  // And the renderer uses them for a mesh without vn: at (1/4, 1/4) on T1
+  // (b0 = 1/2, b1 = b2 = 1/4) document 002's interpolation gives
+  // normalize(m0/2 + (0,0,1)/2), proportional to (20/sqrt(401), 0, 1 + 1/sqrt(401)).
+  Scene scene;
+  Object o;
+  o.kind = Object::Kind::mesh;
+  o.mesh = set;
+  scene.objects.push_back(o);
+  Tracer tr(scene, opts());
+  const auto sp = tr.shading_point({{0.25, 0.25, 3}, {0, 0, -1}});
+  ASSERT_TRUE(sp);
+  const Vec3d want = normalize(Vec3d{20 / r401, 0, 1 + 1 / r401});
+  EXPECT_NEAR(sp->n.x, want.x, 1e-12);
+  EXPECT_NEAR(sp->n.y, 0, 1e-12);
+  EXPECT_NEAR(sp->n.z, want.z, 1e-12);
+  EXPECT_GT(angle(sp->n, normalize(Vec3d{1, 0, 1} * (0.5 / std::sqrt(2.0)) + Vec3d{0, 0, 0.5})), 0.1);
+}
+
 // -------------------------------------------------------------- textures
 
 Texture numbered(int w, int h) {
@@ -214,6 +260,70 @@ TEST(Texture, BilinearWrapsAtTheBorders) {
   EXPECT_NEAR(t.bilinear(1.5 / 4, 0.0).y, (1 + 0) / 2.0, 1e-8);
 }
 
+// The documents' .tga textures, written through OpenImageIO and read back
+// by load_texture. 4 x 2, 8 bits, row 0 at the top:
+//   R = 20 + 40 x (20, 60, 100, 140), G = 50 + 100 y (50 top, 150 bottom),
+//   B = 7.
+// Hand-worked lookups (x = u W, y = H (1 - v), POVRAY.md):
+//  nearest  (0.1, 0.1): x 0.4, y 1.8 -> texel (0, 1) = (20, 150, 7) (v = 0 is the bottom row)
+//           (0.9, 0.9): x 3.6, y 0.2 -> texel (3, 0) = (140, 50, 7)
+//           (1.1, -0.9) repeats (0.1, 0.1); (-0.1, 0.9) repeats (0.9, 0.9)
+//  bilinear (0.4375, 0.625): x + 0.5 = 2.25, y + 0.5 = 1.25: 1/4 of column 2 and
+//           3/4 of column 1, 1/4 of row 1 and 3/4 of row 0:
+//           R = 100/4 + 3*60/4 = 70, G = 150/4 + 3*50/4 = 75
+//           (0, 0): halfway between columns 0 and 3 and rows 1 and 0 (wrapping):
+//           R = (20 + 140)/2 = 80, G = (150 + 50)/2 = 100
+//           (1.4375, -0.375) repeats (0.4375, 0.625)
+void expect_hand_worked_tga_lookups(const Texture& t) {
+  ASSERT_EQ(t.width, 4);
+  ASSERT_EQ(t.height, 2);
+  auto expect = [](const Vec3d& got, double r, double g, double b, const char* what) {
+    EXPECT_NEAR(got.x, r / 255, 1e-6) << what;
+    EXPECT_NEAR(got.y, g / 255, 1e-6) << what;
+    EXPECT_NEAR(got.z, b / 255, 1e-6) << what;
+  };
+  expect(t.nearest(0.1, 0.1), 20, 150, 7, "nearest (0.1, 0.1)");
+  expect(t.nearest(0.9, 0.9), 140, 50, 7, "nearest (0.9, 0.9)");
+  expect(t.nearest(1.1, -0.9), 20, 150, 7, "nearest (1.1, -0.9)");
+  expect(t.nearest(-0.1, 0.9), 140, 50, 7, "nearest (-0.1, 0.9)");
+  expect(t.bilinear(0.4375, 0.625), 70, 75, 7, "bilinear (0.4375, 0.625)");
+  expect(t.bilinear(0.0, 0.0), 80, 100, 7, "bilinear (0, 0)");
+  expect(t.bilinear(1.4375, -0.375), 70, 75, 7, "bilinear (1.4375, -0.375)");
+}
+
+unsigned char tga_level(int x, int y, int c) { return c == 0 ? 20 + 40 * x : c == 1 ? 50 + 100 * y : 7; }
+
+TEST(Texture, TgaWrittenByOiioSamplesTheHandWorkedTexels) {
+  const auto file = temp_dir() / "grid.tga";
+  unsigned char px[2][4][3];
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) px[y][x][c] = tga_level(x, y, c);
+  auto out = OIIO::ImageOutput::create(file.string());
+  ASSERT_TRUE(out) << OIIO::geterror();
+  ASSERT_TRUE(out->open(file.string(), OIIO::ImageSpec(4, 2, 3, OIIO::TypeDesc::UINT8))) << out->geterror();
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, px)) << out->geterror();
+  ASSERT_TRUE(out->close());
+  expect_hand_worked_tga_lookups(load_texture(file));
+}
+
+// The same texels in a TGA written byte by byte the way most tools write
+// it: uncompressed true-colour (type 2), BGR, origin at the BOTTOM left
+// (descriptor bit 5 clear), so the file holds the bottom row first.
+TEST(Texture, BottomUpTgaIsReadUpright) {
+  const auto file = temp_dir() / "bottom-up.tga";
+  std::string bytes(18, '\0');
+  bytes[2] = 2;   // uncompressed true-colour
+  bytes[12] = 4;  // width, little-endian
+  bytes[14] = 2;  // height
+  bytes[16] = 24; // bits per pixel; bytes[17] = 0: bottom-left origin
+  for (int y = 1; y >= 0; --y)
+    for (int x = 0; x < 4; ++x)
+      for (int c : {2, 1, 0}) bytes += char(tga_level(x, y, c));
+  std::ofstream(file, std::ios::binary) << bytes;
+  expect_hand_worked_tga_lookups(load_texture(file));
+}
+
 TEST(Texture, PigmentOfATexturedMeshIsTheTexelAtItsUv) {
   const auto dir = temp_dir();
   // 2 x 2: top-left red, top-right green, bottom-left blue, bottom-right white.
@@ -256,16 +366,57 @@ TEST(Bump, UvBasisFollowsTheUvLayout) {
   EXPECT_FALSE(uv_basis({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0}, {1, 1}, {2, 2}));
 }
 
+// A constant, non-zero height map: its derivatives are exactly 0 (I - I),
+// so n += 0 and bump_height returns n unchanged (no renormalisation, which
+// could move n by an ulp). That early return is the code path BY DESIGN for
+// any flat map; the ramps below exercise the perturbation itself.
 TEST(Bump, HeightVariantOnAFlatMapChangesNothing) {
   Texture flat(8, 8);
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 8; ++x) flat.set(x, y, {0.4, 0.5, 0.6});
   const Texture d = height_derivatives(flat);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) ASSERT_EQ(d.texel(x, y), (Vec3d{0, 0, 0})) << x << ", " << y;
   const UvBasis basis{{1, 0, 0}, {0, 1, 0}};
   const Vec3d n = normalize(Vec3d{0.1, -0.2, 1});
   for (double u : {0.0, 0.3, 0.999})
     for (auto f : {TextureFilter::nearest, TextureFilter::bilinear})
       EXPECT_EQ(bump_height(n, d, f, 10.0, u, 0.7, basis), n);
+}
+
+// Document 002's variant 2 on 8-bit ramps, worked by hand. An x ramp of
+// levels 20 + 30 x: dx = I(x) - I(x+1) = -30/255 inside the image (the
+// last column wraps: 230 - 20 = +210), dy = 0. With n = (0,1,0) on a floor
+// whose +u is +x and +v is -z (so image +y, = -v, is +z), strength 2:
+//   n' = normalize(n + 2 (dx Tu - dy Tv)) = normalize(-60/255, 1, 0).
+// A y ramp of levels 20 + 30 y (brighter towards the BOTTOM, image +y):
+// dy = -30/255, dx = 0: n' = normalize(n - 2 dy Tv) = normalize(0, 1, -60/255),
+// i.e. tilted towards image -y (= +v = -z), away from the high side.
+TEST(Bump, HeightVariantOnRampsGivesTheHandWorkedNormal) {
+  Texture xr(8, 4), yr(4, 8);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) xr.set(x, y, Vec3d{1, 1, 1} * float((20 + 30 * x) / 255.0));
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 4; ++x) yr.set(x, y, Vec3d{1, 1, 1} * float((20 + 30 * y) / 255.0));
+  const UvBasis basis{{1, 0, 0}, {0, 0, -1}};
+  const Vec3d n{0, 1, 0};
+  const double k = 60.0 / 255, len = std::sqrt(1 + k * k);
+  for (auto f : {TextureFilter::nearest, TextureFilter::bilinear}) {
+    // x = 2.5 of 8 (inside: bilinear mixes columns 2 and 3, both -30/255).
+    const Vec3d a = bump_height(n, height_derivatives(xr), f, 2.0, 2.5 / 8, 0.4, basis);
+    EXPECT_NEAR(a.x, -k / len, 1e-7);
+    EXPECT_NEAR(a.y, 1 / len, 1e-7);
+    EXPECT_NEAR(a.z, 0, 1e-15);
+    // y = 2.5 of 8: v = 1 - 2.5/8.
+    const Vec3d b = bump_height(n, height_derivatives(yr), f, 2.0, 0.6, 1 - 2.5 / 8, basis);
+    EXPECT_NEAR(b.x, 0, 1e-15);
+    EXPECT_NEAR(b.y, 1 / len, 1e-7);
+    EXPECT_NEAR(b.z, -k / len, 1e-7);
+  }
+  // The wrapped last column: dx = +210/255, so the tilt reverses.
+  const Vec3d w = bump_height(n, height_derivatives(xr), TextureFilter::nearest, 1.0, 7.5 / 8, 0.4, basis);
+  const double kw = 210.0 / 255;
+  EXPECT_NEAR(w.x, kw / std::sqrt(1 + kw * kw), 1e-7);
 }
 
 TEST(Bump, HeightVariantTiltsAwayFromTheHighSide) {
@@ -281,37 +432,90 @@ TEST(Bump, HeightVariantTiltsAwayFromTheHighSide) {
   EXPECT_NEAR(n.y, 0, 1e-15);
 }
 
-TEST(Bump, NormalMapAndPovOnFlatMapsChangeNothing) {
-  Texture up(4, 4), grey(4, 4);
-  for (int y = 0; y < 4; ++y)
-    for (int x = 0; x < 4; ++x) {
-      up.set(x, y, {0.5, 0.5, 1});
-      grey.set(x, y, {0.3, 0.3, 0.3});
-    }
+// Variant 1 with the texels an 8-bit PNG really holds: "flat" (128, 128, 255)
+// is d = (1/255, 1/255, 1), not (0, 0, 1). With n = (0,1,0), Tu = +x,
+// Tv = -z, strength 1: n' = normalize((1/255, 0, -1/255) + (0, 1, 0))
+// = (1, 255, -1)/sqrt(65027); (127, 127, 255) gives (-1, 255, 1)/sqrt(65027);
+// (255, 128, 128), a normal along +u: normalize(Tu + Tv/255 + n/255)
+// = (255, 1, -1)/sqrt(65027); strength 2 on (128, 128, 255):
+// (2, 255, -2)/sqrt(65033).
+TEST(Bump, NormalMapWithEightBitTexelsGivesTheHandWorkedNormal) {
+  Image img(3, 1);
+  const int texels[3][3] = {{128, 128, 255}, {127, 127, 255}, {255, 128, 128}};
+  for (int x = 0; x < 3; ++x)
+    for (int c = 0; c < 3; ++c) img.at(x, 0)[c] = float(texels[x][c] / 255.0);
+  const auto file = temp_dir() / "normals8.png";
+  write_image(file, img);
+  const Texture map = load_texture(file);
+  ASSERT_NEAR(map.texel(0, 0).x * 255, 128, 1e-4);  // the 8-bit level survived
   const UvBasis basis{{1, 0, 0}, {0, 0, -1}};
   const Vec3d n{0, 1, 0};
-  EXPECT_EQ(bump_normal_map(n, up, TextureFilter::bilinear, 1.0, 0.3, 0.3, basis), n);
+  auto expect = [&](int texel, double strength, Vec3d want) {
+    want = normalize(want);
+    const Vec3d got = bump_normal_map(n, map, TextureFilter::nearest, strength, (texel + 0.5) / 3, 0.5, basis);
+    // The texels are floats: |c - l/255| <= 2^-25 (half an ulp of 0.5), so each
+    // component of d is off by <= 2^-24 ~ 6e-8, times the strength.
+    EXPECT_NEAR(length(got - want), 0, 3e-7) << "texel " << texel << " strength " << strength;
+  };
+  expect(0, 1.0, {1, 255, -1});
+  expect(1, 1.0, {-1, 255, 1});
+  expect(2, 1.0, {255, 1, -1});
+  expect(0, 2.0, {2, 255, -2});
+  // Not "nothing": the 8-bit flat texel tilts n by atan(sqrt(2)/255).
+  const Vec3d flat = bump_normal_map(n, map, TextureFilter::nearest, 1.0, 0.5 / 3, 0.5, basis);
+  EXPECT_NEAR(angle(flat, n), std::atan(std::sqrt(2.0) / 255), 2e-7);
+}
+
+// POV's bump_map on a grey map: the three taps are equal, the triangle
+// (0,h,0), (-1,h,1), (1,h,1) is level and its normal is +Y of the frame = n.
+TEST(Bump, PovOnAFlatMapChangesNothing) {
+  Texture grey(4, 4);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) grey.set(x, y, {0.3, 0.3, 0.3});
   const Vec3d m = normalize(Vec3d{0.3, 0.8, 0.2});
   const Vec3d p = bump_pov(m, grey, TextureFilter::bilinear, 0.5, 0.3, 0.6);
   EXPECT_NEAR(length(p - m), 0, 1e-15);
 }
 
-// Whole renders: a flat height map on a mesh gives the same image as no bump.
-TEST(Bump, FlatHeightMapRendersTheSameImage) {
+// Whole renders of a lit quad in z = 0 facing the camera (+u = +x, +v = +y),
+// ambient 0, diffuse 1, white, the light straight above the traced point so
+// that the pixel is exactly N'.L = N'.z:
+//  - no bump, and a constant non-zero height map (levels 90, 128, 166:
+//    derivatives exactly 0): 1, and the two images are bit-identical;
+//  - an 8-bit x ramp, levels 20 + 30 x, strength 2, nearest: at texel 2,
+//    dx = -30/255, so N' = normalize(-60/255, 0, 1) and the pixel is
+//    1/sqrt(1 + (60/255)^2) = 255/sqrt(68625) (hand: 0.97341...).
+TEST(Bump, FlatHeightMapRendersTheSameImageAndARampTheHandWorkedShade) {
   const auto dir = temp_dir();
-  Image img(4, 4);
-  for (float& v : img.rgb) v = 0.5f;
-  write_image(dir / "flat.png", img);
+  Image flat(4, 4), ramp(8, 2);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) flat.at(x, y)[c] = float((90 + 38 * c) / 255.0);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) ramp.at(x, y)[c] = float((20 + 30 * x) / 255.0);
+  write_image(dir / "flat.png", flat);
+  write_image(dir / "ramp.png", ramp);
   write_text(dir / "q.obj",
              "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
              "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
-  const std::string head = R"({"width": 32, "height": 24, "lights": [{"position": [-2, 1, 3]}],
-      "objects": [{"mesh": "q.obj", "rotate": [["x", -0.8]], "material": {"phong": 0.5)";
+  // u = 2.5/8 -> x = -0.375; v = 0.25 -> y = -0.5.
+  const std::string head = R"({"width": 32, "height": 24, "lights": [{"position": [-0.375, -0.5, 10]}],
+      "camera": {"position": [0, 0, 6]},
+      "objects": [{"mesh": "q.obj", "material": {"ambient": 0, "diffuse": 1)";
   write_text(dir / "plain.json", head + "}}]}");
-  write_text(dir / "bumped.json", head + R"(, "bump": {"file": "flat.png", "strength": 50}}}]})");
-  const Image a = render(load_scene(dir / "plain.json"), opts());
-  const Image b = render(load_scene(dir / "bumped.json"), opts());
-  EXPECT_EQ(a.rgb, b.rgb);
+  write_text(dir / "flat.json", head + R"(, "bump": {"file": "flat.png", "strength": 50}}}]})");
+  write_text(dir / "ramp.json", head + R"(, "bump": {"file": "ramp.png", "strength": 2, "filter": "nearest"}}}]})");
+  const Ray<double> ray{{-0.375, -0.5, 5}, {0, 0, -1}};
+  const Scene plain = load_scene(dir / "plain.json"), flat_s = load_scene(dir / "flat.json"),
+              ramp_s = load_scene(dir / "ramp.json");
+  EXPECT_NEAR(Tracer(plain, opts()).trace(ray).x, 1.0, 1e-12);
+  EXPECT_NEAR(Tracer(flat_s, opts()).trace(ray).x, 1.0, 1e-12);
+  EXPECT_EQ(render(plain, opts()).rgb, render(flat_s, opts()).rgb);
+  const Color c = Tracer(ramp_s, opts()).trace(ray);
+  EXPECT_NEAR(c.x, 255 / std::sqrt(68625.0), 1e-7);
+  EXPECT_EQ(c.x, c.y);
+  EXPECT_NE(render(plain, opts()).rgb, render(ramp_s, opts()).rgb);
 }
 
 // ------------------------------------------------- culling, accelerations

@@ -50,11 +50,11 @@ template <class T> constexpr T gamma(int n) {
   return (n * u) / (1 - n * u);
 }
 
-// Moves every component of p one ulp away from p along the offset's sign.
-template <class T> Vec3<T> step_outward(Vec3<T> po, const Vec3<T>& offset) {
+// Moves every component of po one ulp along the sign of `dir` (none where it is 0).
+template <class T> Vec3<T> step_outward(Vec3<T> po, const Vec3<T>& dir) {
   for (int i = 0; i < 3; ++i) {
-    if (offset[i] > 0) po[i] = std::nextafter(po[i], std::numeric_limits<T>::infinity());
-    else if (offset[i] < 0) po[i] = std::nextafter(po[i], -std::numeric_limits<T>::infinity());
+    if (dir[i] > 0) po[i] = std::nextafter(po[i], std::numeric_limits<T>::infinity());
+    else if (dir[i] < 0) po[i] = std::nextafter(po[i], -std::numeric_limits<T>::infinity());
   }
   return po;
 }
@@ -112,7 +112,11 @@ Ray<T> spawn_ray(SelfIntersection s, const Vec3<T>& p, const Vec3<T>& p_error, V
     case SelfIntersection::normal_offset: {
       const T d = dot(abs(n), p_error);
       const Vec3<T> offset = n * d;
-      const Vec3<T> po = detail::step_outward(p + offset, offset);
+      // One ulp outward along n's signs, not the offset's: with a zero error
+      // bound (a hit on an axis-aligned triangle, e.g. z = 0 for all three
+      // vertices) the offset is zero and the origin would stay ON the
+      // surface, which the window [0, tmax] then meets again at t = 0.
+      const Vec3<T> po = detail::step_outward(p + offset, n);
       // The light is still at p + dir * light_distance; shorten by the offset.
       const T tmax = shadow ? (light_distance - length(po - p)) * (T(1) - detail::gamma<T>(3)) : inf;
       return {po, dir, T(0), tmax};

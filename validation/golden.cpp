@@ -243,8 +243,8 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
     return {false, msg};
   }
   std::error_code ec;
-  fs::create_directories(diff_dir, ec);
   const fs::path diff = diff_dir / (name + ".diff.png"), mine = diff_dir / (name + ".png");
+  fs::create_directories(diff.parent_path(), ec);  // names may hold a folder: corpus/ladder-10-box
   write_image(diff, difference_image(ours, golden, g.bits));
   write_image(mine, ours);
   msg = name + ": differs from " + g.image + " (" + size + ")\n" + summary(c);
@@ -308,7 +308,7 @@ std::string GoldenSet::bless(const std::string& name) {
       what += "; inputs unchanged";
   }
   std::error_code ec;
-  fs::create_directories(root_ / "golden", ec);
+  fs::create_directories((root_ / g.image).parent_path(), ec);
   if (write_png) write_image(root_ / g.image, img, {8, false});
   entries_[name] = g;
   return what;

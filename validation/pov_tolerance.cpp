@@ -28,9 +28,21 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
     if (j.contains("width")) t.width = j.at("width").get<int>();
     if (j.contains("height")) t.height = j.at("height").get<int>();
     t.max_levels_16 = j.value("max_levels_16", t.max_levels_16);
-    for (const auto& p : j.value("pixels", nlohmann::json::array())) {
-      ExplainedPixel e{p.at("x").get<int>(), p.at("y").get<int>(), p.at("cause").get<std::string>()};
-      if (e.cause.empty()) throw InputError(file.string() + ": every listed pixel needs its cause");
+    if (t.max_levels_16 < 0 || t.max_levels_16 > 16)
+      throw InputError(file.string() + ": /max_levels_16: must be 0..16 (POV's float32 colours give 2)");
+    const auto pixels = j.value("pixels", nlohmann::json::array());
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      const auto& p = pixels[i];
+      const std::string at = file.string() + ": /pixels/" + std::to_string(i);
+      for (auto it = p.begin(); it != p.end(); ++it)
+        if (it.key() != "x" && it.key() != "y" && it.key() != "levels" && it.key() != "cause")
+          throw InputError(at + "/" + it.key() + ": unknown key");
+      if (!p.contains("levels"))
+        throw InputError(at + ": needs \"levels\", the largest difference allowed there (8-bit levels)");
+      ExplainedPixel e{p.at("x").get<int>(), p.at("y").get<int>(), p.at("levels").get<int>(),
+                       p.at("cause").get<std::string>()};
+      if (e.levels < 1 || e.levels > 255) throw InputError(at + "/levels: must be 1..255");
+      if (e.cause.empty()) throw InputError(at + ": every listed pixel needs its cause");
       t.pixels.push_back(e);
     }
   } catch (const nlohmann::json::exception& e) {
@@ -55,7 +67,14 @@ PovVerdict judge(const ImageComparison& c, const PovTolerance& t) {
     const std::string at = "pixel (" + std::to_string(d.x) + ", " + std::to_string(d.y) + ") differs by " +
                            std::to_string(d.levels) + (d.levels == 1 ? " level" : " levels");
     if (auto it = listed.find({d.x, d.y}); it != listed.end()) {
-      v.lines.push_back(at + ": explained: " + it->second->cause);
+      const int allowed = c.bits == 16 ? allowed_levels_16(it->second->levels) : it->second->levels;
+      if (d.levels <= allowed) {
+        v.lines.push_back(at + ": explained: " + it->second->cause);
+      } else {
+        v.pass = false;
+        v.lines.push_back(at + ": more than the " + std::to_string(allowed) + " explained in " + where + " (" +
+                          it->second->cause + ")");
+      }
     } else if (c.bits == 16 && d.levels <= t.max_levels_16) {
       continue;  // POV's float32 colours; counted in the summary, not listed
     } else {
