@@ -258,7 +258,9 @@ void expect_same(const ra::oracle::Answer& got, const ra::oracle::Answer& want) 
   EXPECT_EQ(ra::oracle::verdict_name(got.verdict), ra::oracle::verdict_name(want.verdict));
   if (want.verdict == Verdict::hit || want.verdict == Verdict::boundary) {
     EXPECT_EQ(got.t, want.t) << std::hexfloat << got.t << " vs " << want.t;
-    if (want.verdict == Verdict::boundary) EXPECT_EQ(got.zero_edges, want.zero_edges);
+    if (want.verdict == Verdict::boundary) {
+      EXPECT_EQ(got.zero_edges, want.zero_edges);
+    }
   }
 }
 
