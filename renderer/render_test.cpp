@@ -204,5 +204,33 @@ TEST(Render, SupersamplingAveragesTheSubpixelCentres) {
 }
 
 
+// In float, normal-offset must move a secondary ray's origin by float's
+// error bound for the hit point, not double's: on a triangle 1e4 across seen
+// near the origin, the float kernel's error in t for the ray's own triangle
+// (o - v0 is rounded at 1e4's scale, ~1e-3) is far larger than p's own
+// rounding (~1e-7). With double's bound the shadow ray re-hits its own
+// triangle on a large share of pixels; with float's, none does, so every
+// pixel is as lit as in double.
+TEST(Render, FloatNormalOffsetNeverShadowsAHugeTriangleOnItself) {
+  Scene s = parse(R"({"width": 64, "height": 48,
+      "camera": {"position": [0.3, 1.7, 2.1], "look_at": [0.1, 0.2, 0.05]},
+      "lights": [{"position": [3, 9, 5]}],
+      "objects": [{"triangle": [[-9000.3, 0.11, -7000.7], [9300.1, -0.13, -6000.9], [100.7, 0.07, 9800.3]]}]})");
+  for (const char* method : {"moller", "watertight", "baldwin"}) {
+    RenderOptions o = opts();
+    o.self_intersection = SelfIntersection::normal_offset;
+    o.triangle_method = method;
+    const Image lit = Tracer(s, o).render();
+    o.use_double = false;
+    const Image f = Tracer(s, o).render();
+    int shadowed = 0;
+    for (std::size_t i = 0; i < f.rgb.size(); ++i)
+      if (f.rgb[i] < lit.rgb[i] - 0.1) ++shadowed;
+    EXPECT_EQ(shadowed, 0) << method << ": float pixels self-shadowed";
+    // The light does reach the surface: the image is not ambient-only.
+    EXPECT_GT(lit.at(32, 24)[0], 0.2) << method;
+  }
+}
+
 }  // namespace
 }  // namespace ra
