@@ -146,6 +146,43 @@ TEST(AuditCli, ExportThenAuditAgreesOnEveryVerdict) {
   EXPECT_GT(i, 1000u);
 }
 
+TEST(AuditCli, OneUnwritableOutputMeansNoOutputAtAll) {
+  const fs::path json = tmp("half.json");
+  fs::remove(json);
+  const Result r = rayaudit("audit --methods moller --families random --rays 10 --csv /nonexistent/x.csv --json " +
+                            json.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("/nonexistent/x.csv: output directory does not exist"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(json)) << "the JSON was written though the CSV could not be";
+  // Both writable: both written, no temporary left behind.
+  const fs::path csv = tmp("half.csv");
+  ASSERT_EQ(rayaudit("audit --methods moller --families random --rays 10 --csv " + csv.string() + " --json " +
+                     json.string()).code, 0);
+  EXPECT_TRUE(fs::exists(json) && fs::exists(csv));
+  for (const auto& e : fs::directory_iterator(json.parent_path()))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+}
+
+TEST(AuditCli, AbsurdCountsAndIgnoredOptionsAreUsageErrors) {
+  Result r = rayaudit("audit --rays 99999999999999");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("not in range 1 to 100000000"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+  EXPECT_EQ(rayaudit("audit --rays 0").code, 2);
+  EXPECT_EQ(rayaudit("audit --threads -1 --rays 10").code, 2);
+  EXPECT_EQ(rayaudit("audit --seed -1 --rays 10").code, 2);
+  // Options that would be silently ignored.
+  const fs::path csv = tmp("ok.csv");
+  write(csv, kHeader + "0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
+  EXPECT_EQ(rayaudit("audit --cases " + csv.string() + " --csv " + tmp("z.csv").string()).code, 2);
+  EXPECT_EQ(rayaudit("audit --export-cases " + tmp("e.csv").string() + " --families edge --rays 5 --json " +
+                     tmp("e.json").string()).code, 2);
+  // A family none of the chosen methods can grade.
+  r = rayaudit("audit --methods kraus --families edge --rays 10");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no triangle method"), std::string::npos) << r.err;
+}
+
 TEST(AuditCli, UnknownNamesAreUsageErrors) {
   EXPECT_EQ(rayaudit("audit --methods nosuch --rays 10").code, 2);
   EXPECT_EQ(rayaudit("audit --families nosuch --rays 10").code, 2);

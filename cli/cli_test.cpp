@@ -138,6 +138,34 @@ TEST(Cli, UsageErrorsExit2AndHelpExits0) {
   EXPECT_NE(v.out.find("rayaudit"), std::string::npos);
 }
 
+TEST(Cli, UnknownCommandIsNamed) {
+  const auto r = ra::test::run_rayaudit("frobnicate");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown command 'frobnicate'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("render"), std::string::npos) << "lists the commands: " << r.err;
+}
+
+TEST(Cli, NumberOverflowInASceneNamesFileAndLine) {
+  const fs::path dir = temp_dir();
+  std::ofstream(dir / "big.json") << "{\"objects\": [\n  {\"sphere\": {\"center\": [0, 0, 1e999]}}]}";
+  const fs::path out = dir / "big.png";
+  const auto r = ra::test::run_rayaudit("render " + (dir / "big.json").string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("big.json:2: number 1e999 overflows a double"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, ConvertRefusesAnOutputThatIsNotObj) {
+  const fs::path dir = temp_dir();
+  std::ofstream(dir / "t.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  auto r = ra::test::run_rayaudit("convert " + (dir / "t.off").string() + " -o " + (dir / "t.stl").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_FALSE(fs::exists(dir / "t.stl"));
+  r = ra::test::run_rayaudit("convert " + (dir / "t.off").string() + " -o " + (dir / "t.obj").string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir / "t.obj"));
+}
+
 TEST(Cli, NonSquareSppIsRefused) {
   const Result r = run(std::string("render ") + RAYAUDIT_SOURCE_DIR + "/scenes/sphere-on-plane.json -o " +
                        (temp_dir() / "spp.png").string() + " --spp 3");

@@ -19,6 +19,9 @@ namespace {
 
 using namespace ra::audit;
 
+// Above this an audit runs for hours and its task list alone takes gigabytes.
+constexpr long long kMaxRays = 100000000;
+
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases;
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
@@ -96,6 +99,9 @@ std::function<void(std::size_t, std::size_t)> progress_bar() {
 nlohmann::json t_json(double t) { return std::isfinite(t) ? nlohmann::json(t) : nlohmann::json(nullptr); }
 
 void audit_cases(const Args& a) {
+  if (!a.csv.empty())
+    throw ra::InputError("audit: --csv writes per-family rows, which --cases has none of; use --json");
+  ra::OutputBatch outputs({a.json});
   const auto cases = read_cases_csv(a.cases);  // throws before anything is written
   std::vector<const ra::Method*> tri_methods;
   for (const ra::Method* m : chosen_methods(a.methods))
@@ -138,10 +144,15 @@ void audit_cases(const Args& a) {
   }
   std::printf("%zu case(s); %d answer(s) contradict the exact verdict (marked !)\n", cases.size(), wrong);
   if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"cases", out}}.dump(2) + "\n");
+  outputs.commit();
 }
 
 // --------------------------------------------------- --export-cases ---
 void export_cases(const Args& a) {
+  if (!a.json.empty() || !a.csv.empty())
+    throw ra::InputError("audit: --export-cases writes only the cases CSV; run the audit separately for --json/--csv");
+  if (!a.methods.empty()) throw ra::InputError("audit: --export-cases exports cases, not methods' answers: drop --methods");
+  ra::check_output_path(a.export_cases);
   const auto precisions = chosen_precisions(a.precision);
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
@@ -154,6 +165,7 @@ void export_cases(const Args& a) {
 
 // ------------------------------------------------------------ audit ---
 void audit(const Args& a) {
+  ra::OutputBatch outputs({a.json, a.csv});
   const auto ms = chosen_methods(a.methods);
   const auto ps = chosen_precisions(a.precision);
   Options opt;
@@ -169,10 +181,22 @@ void audit(const Args& a) {
       if (m->kind == ra::Kind::triangle) tris.push_back(registry_triangle(*m, p));
       else spheres.push_back(registry_sphere(*m, p));
     }
+  if (!a.families.empty()) {
+    // A family graded by none of the chosen methods would be an empty table.
+    for (const auto& name : opt.families) {
+      const Family* f = find_family(name);
+      const bool graded = f->kind == ra::Kind::triangle ? !tris.empty() : !spheres.empty();
+      if (!graded)
+        throw ra::InputError("audit: family '" + name + "' is a " + (f->kind == ra::Kind::triangle ? "triangle" : "sphere") +
+                             " family, but no " + (f->kind == ra::Kind::triangle ? "triangle" : "sphere") +
+                             " method is chosen (--methods)");
+    }
+  }
   const Report rep = run(tris, spheres, opt);
   std::fputs(rep.summary_table().c_str(), stdout);
   if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
+  outputs.commit();
 }
 
 void setup(CLI::App& app) {
@@ -185,11 +209,15 @@ void setup(CLI::App& app) {
   cmd->add_option("--rays", a->rays,
                   "Ray/primitive tests per family per method and precision (a ray against a fan of 6 counts 6)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--seed", a->seed, "Seed of every generated case")->capture_default_str();
+      ->check(CLI::Range(1LL, kMaxRays).description("1 to 100000000 (about 20 minutes on 2 cores)"));
+  cmd->add_option("--seed", a->seed, "Seed of every generated case")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& v) { return v.find('-') == std::string::npos ? std::string() : "the seed is a non-negative integer"; },
+          "UINT64"));
   cmd->add_option("--threads", a->threads, "Worker threads (0: all cores); results do not depend on it")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1024));
   cmd->add_option("--json", a->json, "Write every count to this JSON file");
   cmd->add_option("--csv", a->csv, "Write one row per method x precision x family x sweep value");
   auto* cases = cmd->add_option("--cases", a->cases,

@@ -35,6 +35,7 @@ void run(const Args& a) {
                 << ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)\n";
       throw ra::cli::ExitCode{kSkipped};
     }
+  ra::OutputBatch outputs({a.json_out, a.diff_out, a.ours_out, a.pov_out});
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
   if (a.height > 0) scene.height = a.height;
@@ -45,6 +46,10 @@ void run(const Args& a) {
     }
     throw ra::InputError(a.scene + ": POV-Ray cannot express this scene: " + *reason);
   }
+  // The default tolerance file may be absent (identical at 8 bits); one named
+  // on the command line must exist.
+  if (!a.tolerance.empty() && !std::filesystem::is_regular_file(a.tolerance))
+    throw ra::InputError(a.tolerance + ": no such tolerance file");
   const ra::PovTolerance tol =
       ra::load_pov_tolerance(a.tolerance.empty() ? ra::pov_tolerance_path(a.scene) : std::filesystem::path(a.tolerance));
 
@@ -90,6 +95,7 @@ void run(const Args& a) {
     }
     ra::write_text_atomically(a.json_out, j.dump(2) + "\n");
   }
+  outputs.commit();  // also when the check fails: the diff and JSON say why
   if (!v.pass)
     throw ra::CheckFailed(a.scene + ": our render differs from POV-Ray's beyond what " +
                           (tol.file.empty() ? std::string("the default (identical at 8 bits)") : tol.file.string()) +
@@ -109,7 +115,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--tolerance", args->tolerance, "Tolerance file (default scenes/pov/NAME.json beside the scene)");
   cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
-  cmd->add_option("--threads", args->threads, "Threads for our render (default: all cores)");
+  cmd->add_option("--threads", args->threads, "Threads for our render (default: all cores)")->check(CLI::Range(0, 1024));
   cmd->add_flag("--explain", args->explain,
                 "Test each differing pixel for the known causes (float32 mesh data, POV's shadow cache)");
   cmd->add_flag("--keep-pov-dir", args->keep, "Keep POV-Ray's working directory (scene.pov, ini, images)");

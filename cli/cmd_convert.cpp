@@ -2,6 +2,7 @@
 // OFF to OBJ by our own readers (renderer/polymesh_io.h), written atomically.
 #include <cstdio>
 
+#include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "polymesh_io.h"
@@ -20,6 +21,9 @@ void setup(CLI::App& app) {
   cmd->add_option("--from", o->from, "Input format when the extension does not say: ply or off")
       ->check(CLI::IsMember({"ply", "off"}));
   cmd->callback([o] {
+    const std::string out_ext = std::filesystem::path(o->out).extension().string();
+    if (out_ext != ".obj" && out_ext != ".OBJ") throw ra::InputError(o->out + ": the output must be a .obj file");
+    ra::check_output_path(o->out);
     std::string fmt = o->from;
     if (fmt.empty()) {
       const std::string ext = std::filesystem::path(o->in).extension().string();

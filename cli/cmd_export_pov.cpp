@@ -28,14 +28,19 @@ std::string safe_prefix(const std::filesystem::path& out) {
 void run(const Args& a) {
   const std::filesystem::path out(a.out);
   if (out.extension() != ".pov") throw ra::InputError(a.out + ": output must be a .pov file");
+  ra::OutputBatch outputs({out, a.ini});
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
   if (a.height > 0) scene.height = a.height;
   const ra::PovExport ex = ra::export_pov(scene, safe_prefix(out));
   const std::filesystem::path dir = out.has_parent_path() ? out.parent_path() : std::filesystem::path(".");
-  for (const auto& img : ex.images) ra::copy_pov_image(img.source, dir / img.name);
+  for (const auto& img : ex.images) {
+    outputs.add(dir / img.name);
+    ra::copy_pov_image(img.source, dir / img.name);
+  }
   ra::write_text_atomically(out, ex.sdl);
   if (!a.ini.empty()) ra::write_text_atomically(a.ini, ra::pov_ini(8));
+  outputs.commit();
   std::cout << "wrote " << out.string();
   if (!ex.images.empty()) std::cout << " and " << ex.images.size() << " image(s) beside it";
   std::cout << "\nrender it from " << dir.string() << " with: povray " << (a.ini.empty() ? "YOUR.ini" : a.ini)

@@ -34,12 +34,22 @@ std::vector<std::string> names_of(const std::vector<std::string>& given, const r
   return out;
 }
 
+// --root must be a checkout: scenes/ beside golden/ (bless may create golden/).
+void check_root(const Args& a) {
+  if (!std::filesystem::is_directory(std::filesystem::path(a.root) / "scenes"))
+    throw ra::InputError(a.root + ": not a rayaudit repository (no scenes/ directory)");
+}
+
 void check(const Args& a) {
+  check_root(a);
   const ra::GoldenSet set(a.root);
   const std::filesystem::path diff_dir =
       a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden" : std::filesystem::path(a.diff_dir);
   int failed = 0, skipped = 0;
   const auto names = names_of(a.scenes, set);
+  if (names.empty())
+    throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
+                         ": no golden images to check");
   for (const auto& n : names) {
     const auto missing = ra::missing_cache_inputs(std::filesystem::path(a.root) / "scenes" / (n + ".json"));
     if (a.skip_unavailable && !missing.empty()) {
@@ -59,6 +69,7 @@ void check(const Args& a) {
 }
 
 void bless(const Args& a) {
+  check_root(a);
   ra::GoldenSet set(a.root);
   for (const auto& n : names_of(a.scenes, set)) std::cout << set.bless(n) << "\n";
   set.save();

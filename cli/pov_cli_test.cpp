@@ -118,6 +118,42 @@ TEST(CompareCli, ReportsIdenticalAndWritesJsonAndDiff) {
   fs::remove_all(dir);
 }
 
+TEST(CompareCli, OneUnwritableOutputMeansNoOutputAtAll) {
+  const fs::path dir = temp_dir("compare-half");
+  Result r = run("compare " + kSphereOnPlane + " --width 40 --height 30 --json /nonexistent/c.json --diff " +
+                 (dir / "d.png").string() + " --ours " + (dir / "o.png").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_TRUE(fs::is_empty(dir)) << "compare wrote outputs though --json could not be written";
+  // A tolerance file named on the command line must exist.
+  r = run("compare " + kSphereOnPlane + " --width 40 --height 30 --tolerance " + (dir / "none.json").string());
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("none.json: no such tolerance file"), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(ExportPovCli, OneUnwritableOutputMeansNoOutputAtAll) {
+  const fs::path dir = temp_dir("export-half");
+  const std::string textured = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/teapot-textured.json";
+  Result r = run("export-pov " + textured + " -o " + (dir / "t.pov").string() + " --ini /nonexistent/t.ini");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_TRUE(fs::is_empty(dir)) << "export-pov wrote the .pov or its textures though the ini could not be written";
+  r = run("export-pov " + textured + " -o " + (dir / "t.pov").string() + " --ini " + (dir / "t.ini").string());
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(dir / "t.pov") && fs::exists(dir / "t.ini") && fs::exists(dir / "t-tex0.png")) << r.out;
+  fs::remove_all(dir);
+}
+
+TEST(GoldenCli, ARootThatIsNotACheckoutIsAUsageError) {
+  const fs::path dir = temp_dir("golden-root");
+  for (const char* sub : {"check", "bless"}) {
+    const Result r = run(std::string("golden ") + sub + " --root " + (dir / "nope").string());
+    EXPECT_EQ(r.code, 2) << sub << ": " << r.out;
+    EXPECT_NE(r.out.find("not a rayaudit repository"), std::string::npos) << r.out;
+  }
+  EXPECT_TRUE(fs::is_empty(dir)) << "bless created files under a wrong --root";
+  fs::remove_all(dir);
+}
+
 TEST(CompareCli, SaysClearlyWhenPovRayIsMissing) {
   const Result r = run("compare " + kSphereOnPlane, "env PATH=/nonexistent");
   EXPECT_EQ(r.code, 2) << r.out;

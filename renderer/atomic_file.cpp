@@ -18,8 +18,7 @@ void write_atomically(const std::filesystem::path& path,
   namespace fs = std::filesystem;
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw InputError(located(path.string(), 0, "output directory does not exist"));
+  check_output_path(path);
   std::random_device rd;
   const fs::path tmp = dir / (".tmp-" + std::to_string(rd()) + "-" + path.filename().string());
   try {
@@ -28,11 +27,78 @@ void write_atomically(const std::filesystem::path& path,
     fs::remove(tmp, ec);
     throw;
   }
+  if (OutputBatch::stage(path, tmp)) return;
   fs::rename(tmp, path, ec);
   if (ec) {
     fs::remove(tmp, ec);
     throw InputError(located(path.string(), 0, "cannot write: " + ec.message()));
   }
+}
+
+void check_output_path(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw InputError(located(path.string(), 0, "output directory does not exist"));
+  if (fs::is_directory(path, ec)) throw InputError(located(path.string(), 0, "is a directory, not a file"));
+}
+
+namespace {
+thread_local OutputBatch* g_batch = nullptr;
+std::filesystem::path key(const std::filesystem::path& p) { return std::filesystem::absolute(p).lexically_normal(); }
+}  // namespace
+
+OutputBatch::OutputBatch(const std::vector<std::filesystem::path>& outputs) : outer_(g_batch) {
+  for (const auto& p : outputs)
+    if (!p.empty()) add(p);
+  g_batch = this;
+}
+
+void OutputBatch::add(const std::filesystem::path& output) {
+  check_output_path(output);
+  outputs_.push_back(key(output));
+}
+
+bool OutputBatch::stage(const std::filesystem::path& path, const std::filesystem::path& tmp) {
+  OutputBatch* b = g_batch;
+  if (!b) return false;
+  const auto k = key(path);
+  for (const auto& o : b->outputs_)
+    if (o == k) {
+      // The same output written twice: the later file wins.
+      for (auto& [t, f] : b->staged_)
+        if (f == k) {
+          std::error_code ec;
+          std::filesystem::remove(t, ec);
+          t = tmp;
+          return true;
+        }
+      b->staged_.emplace_back(tmp, k);
+      return true;
+    }
+  return false;
+}
+
+void OutputBatch::commit() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (std::size_t i = 0; i < staged_.size(); ++i) {
+    fs::rename(staged_[i].first, staged_[i].second, ec);
+    if (ec) {
+      const std::string what = located(staged_[i].second.string(), 0, "cannot write: " + ec.message());
+      for (std::size_t j = i; j < staged_.size(); ++j) fs::remove(staged_[j].first, ec);
+      staged_.clear();
+      throw InputError(what);
+    }
+  }
+  staged_.clear();
+}
+
+OutputBatch::~OutputBatch() {
+  std::error_code ec;
+  for (const auto& s : staged_) std::filesystem::remove(s.first, ec);
+  g_batch = outer_;
 }
 
 void write_text_atomically(const std::filesystem::path& path, const std::string& text) {

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace ra {
 
@@ -15,5 +17,35 @@ void write_atomically(const std::filesystem::path& path,
 
 // Convenience: atomically writes a string.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+// Throws InputError `PATH: ...` unless `path` can be an output: its directory
+// exists and it is not itself a directory. Commands call it for every output
+// before doing any work, so a bad path costs nothing.
+void check_output_path(const std::filesystem::path& path);
+
+// A command with several outputs writes all of them or none. While a batch is
+// alive, write_atomically() to one of its outputs leaves the finished
+// temporary file in place; commit() renames them all; a batch destroyed
+// without commit() (an error was thrown) removes them. Writes to paths the
+// batch does not list (e.g. POV-Ray's scratch files) are not deferred.
+class OutputBatch {
+ public:
+  // Checks each non-empty path with check_output_path().
+  explicit OutputBatch(const std::vector<std::filesystem::path>& outputs);
+  ~OutputBatch();
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+  // Adds an output known only later (e.g. a texture copied beside a .pov).
+  void add(const std::filesystem::path& output);
+  void commit();
+
+  // Used by write_atomically: true if `path` is this batch's (the rename waits).
+  static bool stage(const std::filesystem::path& path, const std::filesystem::path& tmp);
+
+ private:
+  std::vector<std::filesystem::path> outputs_;  // absolute, normalised
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // tmp, final
+  OutputBatch* outer_;
+};
 
 }  // namespace ra

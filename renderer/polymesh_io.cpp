@@ -43,6 +43,12 @@ struct Tokens {
     while (p < e && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n') ++p;
     return {b, size_t(p - b)};
   }
+  // The next number on this line (OFF's lines are records).
+  template <class T>
+  T number_on_line(const char* what) {
+    if (at_eol()) fail(std::string("expected ") + what + ", found the end of the line");
+    return number<T>(what);
+  }
   template <class T>
   T number(const char* what) {
     skip(true);
@@ -180,6 +186,7 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
   m.face_start.push_back(0);
   BinReader br{reinterpret_cast<const unsigned char*>(t.p), reinterpret_cast<const unsigned char*>(bytes.data()),
                reinterpret_cast<const unsigned char*>(bytes.data() + bytes.size()), format == 2, name};
+  bool vertices_read = false;  // faces after the vertex element are checked where they are
   for (const auto& el : elements) {
     const bool is_vertex = el.name == "vertex", is_face = el.name == "face";
     int ix = -1, iy = -1, iz = -1, ilist = -1;
@@ -207,6 +214,15 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
           }
           if (int(i) == ilist) {
             if (c < 3) t.fail("face with fewer than 3 vertices");
+            if (vertices_read)
+              for (size_t k = m.indices.size() - size_t(c); k < m.indices.size(); ++k)
+                if (m.indices[k] < 0 || m.indices[k] >= long(m.positions.size())) {
+                  const std::string what = "face " + std::to_string(r) + " has vertex index " +
+                                           std::to_string(m.indices[k]) + " out of range (" +
+                                           std::to_string(m.positions.size()) + " vertices, from 0)";
+                  if (format == 0) t.fail(what);
+                  throw InputError(located(name, 0, "byte " + std::to_string(br.p - br.b) + ": " + what));
+                }
             m.face_start.push_back(int(m.indices.size()));
           }
         } else {
@@ -220,6 +236,7 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       if (format == 0 && !t.at_eol()) t.fail("extra values on a PLY data line");
       if (format == 0) t.next_line();
     }
+    vertices_read = vertices_read || is_vertex;
   }
   check_faces(m, name);
   return m;
@@ -238,9 +255,9 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
   for (long i = 0; i < nv; ++i) {
     t.skip(true);
     Vec3d p;
-    p.x = t.number<double>("coordinate");
-    p.y = t.number<double>("coordinate");
-    p.z = t.number<double>("coordinate");
+    p.x = t.number_on_line<double>("x coordinate");
+    p.y = t.number_on_line<double>("y coordinate");
+    p.z = t.number_on_line<double>("z coordinate");
     m.positions.push_back(p);
     t.next_line();
   }
@@ -249,7 +266,12 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
     t.skip(true);
     const long n = t.number<long>("face size");
     if (n < 3 || n > 1000000) t.fail("face with " + std::to_string(n) + " vertices");
-    for (long j = 0; j < n; ++j) m.indices.push_back(t.number<int>("vertex index"));
+    for (long j = 0; j < n; ++j) {
+      const int v = t.number_on_line<int>("vertex index");
+      if (v < 0 || v >= nv)
+        t.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices, from 0)");
+      m.indices.push_back(v);
+    }
     m.face_start.push_back(int(m.indices.size()));
     t.next_line();  // colour values, if any
   }

@@ -73,7 +73,18 @@ TEST(Ply, Errors) {
               "r.ply");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "r.ply: face 0 has vertex index 9 out of range (5 vertices)");
+    // ply, format, 8 header lines, 5 vertices: the face is line 16.
+    EXPECT_STREQ(e.what(), "r.ply:16: face 0 has vertex index 9 out of range (5 vertices, from 0)");
+  }
+  // Binary: no lines, so the byte offset after the face's list.
+  std::string body = binary_body(false);
+  body[body.size() - 13 - 4] = 9;  // the quad's last index (the triangle takes the last 13 bytes), little endian
+  try {
+    parse_ply(std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + body, "b.ply");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.ply: byte "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("face 0 has vertex index 9 out of range"), std::string::npos) << e.what();
   }
 }
 
@@ -88,7 +99,21 @@ TEST(Off, Errors) {
     parse_off("OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 x\n", "e.off");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "e.off:6: malformed coordinate 'x'");
+    EXPECT_STREQ(e.what(), "e.off:6: malformed z coordinate 'x'");
+  }
+  // A vertex line one value short is an error at that line, not a misread
+  // of the next line's first value as its z.
+  try {
+    parse_off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1\n3 0 1 2\n", "short.off");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "short.off:5: expected z coordinate, found the end of the line");
+  }
+  try {
+    parse_off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", "index.off");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "index.off:6: vertex index 7 out of range (3 vertices, from 0)");
   }
 }
 

@@ -263,6 +263,16 @@ Scene parse_scene_json(const std::string& text, const std::filesystem::path& fil
     const auto colon = msg.find("syntax error");
     if (colon != std::string::npos) msg = msg.substr(colon);
     throw InputError(located(file.string(), line_of(text, e.byte == 0 ? 0 : e.byte - 1), "invalid JSON: " + msg));
+  } catch (const json::out_of_range& e) {
+    // "[json.exception.out_of_range.406] number overflow parsing '1e999'":
+    // no position is given, so the line is that of the number's first
+    // occurrence in the text.
+    const std::string msg = e.what();
+    const auto q = msg.find('\'');
+    const std::string number = q == std::string::npos ? "" : msg.substr(q + 1, msg.rfind('\'') - q - 1);
+    const auto at = number.empty() ? std::string::npos : text.find(number);
+    throw InputError(located(file.string(), at == std::string::npos ? 0 : line_of(text, at),
+                             "number " + (number.empty() ? std::string("out of range") : number + " overflows a double")));
   }
   Scene s;
   s.file = file;
