@@ -128,14 +128,16 @@ Filtered filtered_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const 
 // A second filter between the intervals and GMP. Every quantity is evaluated
 // in double-double (about 106 bits) next to a rigorous bound on its error of
 // the form K u^2 P, where P is the polynomial's permanent (the same expression
-// over absolute values) and u = 2^-53. Each double-double add or multiply
-// commits an error of at most 4 u^2 times the sum of its operands'
-// magnitudes (Dekker; Joldes, Muller and Popescu 2017), and the inputs'
+// over absolute values) and u = 2^-53. A double-double add errs by at most
+// 3 u^2 times the sum of its operands' magnitudes, a product of two
+// double-doubles by 8 u^2 times the product of theirs and one by a double by
+// 3 u^2 (Dekker; Joldes, Muller and Popescu 2017), and the inputs'
 // differences are exact (two_sum), so a degree-3 triangle quantity errs by
-// less than 24 u^2 P and a degree-4 sphere quantity by less than 64 u^2 P;
-// the constants below take 8 times that. Signs are certain when the value
-// exceeds its bound, and t is certain when its enclosure stays clear of the
-// midpoints between doubles, so rounding to nearest is decided exactly.
+// less than 24 u^2 P (20 by this count) and a degree-4 sphere quantity by
+// less than 64 u^2 P (34); the constants below take 8 times that. Signs are
+// certain when the value exceeds its bound, and t is certain when its
+// enclosure stays clear of the midpoints between doubles, so rounding to
+// nearest is decided exactly.
 // Range guard: every input is a multiple of 2^E and below 2^M; with
 // deg * E >= -960 and deg * (M + 3) <= 960 no partial result underflows or
 // overflows, so the u^2 analysis holds. Anything else goes to GMP.
@@ -235,7 +237,8 @@ inline bool certified_round(DD t, double err, double& out) {
   return true;
 }
 
-// q = n / d in double-double with relative error below 8 u^2 (d.h != 0).
+// q = n / d in double-double with relative error 8 u^2 + O(u^3) (d.h != 0);
+// callers allow 16 u^2.
 inline DD ddiv(DD n, DD d) {
   const double q1 = n.h / d.h;
   const DD p = d * q1;
@@ -479,11 +482,22 @@ int cmp_ratio(Scratch& s, const Z& num, const Z& den, double x) {
 }
 
 // num / den correctly rounded to double (den > 0).
+// Rounding to 53 bits and then to a subnormal double would round twice (e.g.
+// t = (2^52 + 4/3) 2^-1075 gave 2^-1023 instead of 2^-1023 + 2^-1074), so the
+// rounding is done in double's own exponent range, subnormals included
+// (MPFR's documented mpfr_subnormalize idiom).
 double round_ratio(Scratch& s, const Z& num, const Z& den) {
   mpz_set(mpq_numref(s.q), num.v);
   mpz_set(mpq_denref(s.q), den.v);
-  mpfr_set_q(s.f53, s.q, MPFR_RNDN);
-  return mpfr_get_d(s.f53, MPFR_RNDN);
+  const mpfr_exp_t emin = mpfr_get_emin(), emax = mpfr_get_emax();
+  mpfr_set_emin(-1073);
+  mpfr_set_emax(1024);
+  const int inex = mpfr_set_q(s.f53, s.q, MPFR_RNDN);
+  mpfr_subnormalize(s.f53, inex, MPFR_RNDN);
+  const double d = mpfr_get_d(s.f53, MPFR_RNDN);
+  mpfr_set_emin(emin);
+  mpfr_set_emax(emax);
+  return d;
 }
 
 // t = N / D exactly rounded, for a crossing the filter already certified.
@@ -559,10 +573,10 @@ Answer triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
 // ---------------------------------------------------------------- sphere ---
 namespace {
 
-// sign(root - x) for root = (-B + s sqrt(disc)) / A, A > 0, disc >= 0: compares
-// s sqrt(disc) with Y = x A + B, both scaled by 2^k when x has a fraction.
-int cmp_root(Scratch& sc, int s, double x) {
-  const Split sx = split(x);
+// sign(root - x) for root = (-B + s sqrt(disc)) / A, A > 0, disc >= 0, and
+// x = sx.m 2^sx.e: compares s sqrt(disc) with Y = x A + B, both scaled by 2^k
+// when x has a fraction.
+int cmp_root(Scratch& sc, int s, Split sx) {
   Z& Y = sc.t0;
   Z& disc = sc.t1;
   mpz_mul_si(Y.v, sc.sA.v, static_cast<long>(sx.m));
@@ -585,6 +599,46 @@ int cmp_root(Scratch& sc, int s, double x) {
   return s > 0 ? mag : -mag;
 }
 
+int cmp_root(Scratch& sc, int s, double x) { return cmp_root(sc, s, split(x)); }
+
+// (a + b) / 2 exactly, for adjacent finite doubles a < b.
+Split midpoint(double a, double b) {
+  Split sa = split(a), sb = split(b);
+  if (sa.m == 0) sa.e = sb.e;
+  if (sb.m == 0) sb.e = sa.e;
+  const int e = std::min(sa.e, sb.e);  // the exponents differ by at most 1
+  return {sa.m * (std::int64_t(1) << (sa.e - e)) + sb.m * (std::int64_t(1) << (sb.e - e)), e - 1};
+}
+
+// The double nearest to root s (ties to even), from a guess t a few ulps off at
+// most: t moves by one ulp while the root is beyond a midpoint next to it.
+double nearest_root(Scratch& sc, int s, double t) {
+  auto odd = [](double x) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    return (bits & 1) != 0;
+  };
+  for (;;) {
+    if (!std::isfinite(t)) return t;
+    const double up = std::nextafter(t, HUGE_VAL), down = std::nextafter(t, -HUGE_VAL);
+    if (std::isfinite(up)) {
+      const int c = cmp_root(sc, s, midpoint(t, up));
+      if (c > 0 || (c == 0 && odd(t))) {
+        t = up;
+        continue;
+      }
+    }
+    if (std::isfinite(down)) {
+      const int c = cmp_root(sc, s, midpoint(down, t));
+      if (c < 0 || (c == 0 && odd(t))) {
+        t = down;
+        continue;
+      }
+    }
+    return t;
+  }
+}
+
 bool root_in_window(Scratch& sc, int s, double lo, double hi) {
   if (cmp_root(sc, s, lo) < 0) return false;
   return !std::isfinite(hi) || cmp_root(sc, s, hi) <= 0;
@@ -592,6 +646,11 @@ bool root_in_window(Scratch& sc, int s, double lo, double hi) {
 
 // The roots q / A and C / q with q = -(B + sign(B) sqrt(disc)) (no cancellation),
 // in MPFR at a precision well above the integers' sizes, then rounded to double.
+// That precision does not make the rounding exact: a root can be closer to a
+// midpoint m between doubles than the MPFR error (A m^2 + 2 B m + C is only
+// bounded below by the square of m's last bit), and such roots were rounded to
+// the wrong side (OracleDD.SphereRootsWithin2ToMinus200OfAMidpoint), so the
+// MPFR value is only a guess that nearest_root settles exactly.
 void sphere_roots(Scratch& sc, double& t_near, double& t_far) {
   const auto bits = std::max({mpz_sizeinbase(sc.sA.v, 2), mpz_sizeinbase(sc.sB.v, 2),
                               mpz_sizeinbase(sc.sC.v, 2), mpz_sizeinbase(sc.disc.v, 2) / 2});
@@ -609,8 +668,8 @@ void sphere_roots(Scratch& sc, double& t_near, double& t_far) {
     mpfr_div(sc.big3, sc.big3, sc.big1, MPFR_RNDN);
     r2 = mpfr_get_d(sc.big3, MPFR_RNDN);
   }
-  t_near = std::min(r1, r2);
-  t_far = std::max(r1, r2);
+  t_near = nearest_root(sc, -1, std::min(r1, r2));  // A > 0: the smaller root is -sqrt
+  t_far = nearest_root(sc, 1, std::max(r1, r2));
 }
 
 }  // namespace
