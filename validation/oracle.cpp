@@ -222,6 +222,67 @@ inline bool in_range(std::initializer_list<double> xs, int deg) {
   return deg * lo >= -960 && deg * (hi + 3) <= 960;
 }
 
+// A signed 256-bit integer in two's complement, only for summing products of
+// three int64s exactly (each below 2^189).
+struct I256 {
+  std::uint64_t w[4] = {0, 0, 0, 0};
+  void add_product(std::int64_t a, std::int64_t b, std::int64_t c) {
+    using U128 = unsigned __int128;
+    const bool neg = (a < 0) != (b < 0) != (c < 0);
+    auto mag = [](std::int64_t x) { return x < 0 ? std::uint64_t(0) - std::uint64_t(x) : std::uint64_t(x); };
+    const U128 ab = U128(mag(a)) * mag(b);
+    const U128 p0 = U128(std::uint64_t(ab)) * mag(c);
+    const U128 p1 = U128(std::uint64_t(ab >> 64)) * mag(c) + (p0 >> 64);
+    std::uint64_t m[4] = {std::uint64_t(p0), std::uint64_t(p1), std::uint64_t(p1 >> 64), 0};
+    if (neg) {  // -m = ~m + 1
+      unsigned carry = 1;
+      for (auto& x : m) {
+        x = ~x + carry;
+        carry = carry && x == 0;
+      }
+    }
+    unsigned carry = 0;
+    for (int i = 0; i < 4; ++i) {
+      const U128 sum = U128(w[i]) + m[i] + carry;
+      w[i] = std::uint64_t(sum);
+      carry = unsigned(sum >> 64);
+    }
+  }
+  int sign() const {
+    if (w[3] >> 63) return -1;
+    return (w[0] | w[1] | w[2] | w[3]) ? 1 : 0;
+  }
+};
+
+// The exact sign of (p x q) . d when every double involved (p and q are exact
+// differences, high and low parts) is an integer multiple of a common 2^E
+// below 2^(E+61): scaled by 2^-E each is an int64 and the determinant a sum
+// of 24 products of three, below 2^(3*61+5), summed exactly in 256 bits.
+// This settles the edge functions that are exactly zero (a ray aimed at a
+// point of an edge, as the audit's edge and vertex families are built on a
+// grid), where any filter can only say "too close to call"; else 2.
+int grid_det_sign(const DV& p, const DV& q, const Vec3d& d) {
+  const double xs[15] = {p.x.h, p.y.h, p.z.h, q.x.h, q.y.h, q.z.h, d.x, d.y, d.z,
+                         p.x.l, p.y.l, p.z.l, q.x.l, q.y.l, q.z.l};
+  int lo = 10000, hi = -10000;
+  for (double x : xs) range(x, lo, hi);
+  if (lo == 10000) return 0;
+  if (hi - lo > 61) return 2;
+  std::int64_t v[15];
+  for (int i = 0; i < 15; ++i) v[i] = static_cast<std::int64_t>(std::ldexp(xs[i], -lo));  // exact
+  // Coordinate k of p is v[k] + v[9 + k], of q v[3 + k] + v[12 + k]; d's is v[6 + k].
+  I256 det;
+  auto term = [&](int i, int j, int k, bool minus) {  // +- p_i q_j d_k
+    for (int pi : {i, 9 + i})
+      for (int qj : {3 + j, 12 + j})
+        if (v[pi] && v[qj]) det.add_product(minus ? -v[pi] : v[pi], v[qj], v[6 + k]);
+  };
+  term(1, 2, 0, false), term(2, 1, 0, true);
+  term(2, 0, 1, false), term(0, 2, 1, true);
+  term(0, 1, 2, false), term(1, 0, 2, true);
+  return det.sign();
+}
+
 // The double nearest to a value v known only as t (double-double, finite,
 // normalised so t.h = round(t.h + t.l)) within absolute error err: true and
 // sets out when every value in [t - err, t + err] rounds to the same double.
@@ -295,9 +356,12 @@ bool dd_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c, 
   if (is_d(ao)) zero[0] = zero[2] = true;
   if (is_d(bo)) zero[0] = zero[1] = true;
   if (is_d(co)) zero[1] = zero[2] = true;
-  const int w[3] = {zero[0] ? 0 : dsign(ddot(dcross(ao, bo), r.d), ew[0]),
-                    zero[1] ? 0 : dsign(ddot(dcross(bo, co), r.d), ew[1]),
-                    zero[2] ? 0 : dsign(ddot(dcross(co, ao), r.d), ew[2])};
+  int w[3] = {zero[0] ? 0 : dsign(ddot(dcross(ao, bo), r.d), ew[0]),
+              zero[1] ? 0 : dsign(ddot(dcross(bo, co), r.d), ew[1]),
+              zero[2] ? 0 : dsign(ddot(dcross(co, ao), r.d), ew[2])};
+  const DV* rows[4] = {&ao, &bo, &co, &ao};
+  for (int i = 0; i < 3; ++i)
+    if (w[i] == 2) w[i] = grid_det_sign(*rows[i], *rows[i + 1], r.d);
   for (int s : w)
     if (s == -sD) return out = make(Verdict::miss), true;
   for (int s : w)

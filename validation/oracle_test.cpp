@@ -361,41 +361,47 @@ TEST(OracleReference, VertexHitsAtLargeOffsets) {
 // Near-boundary cases that the filters cannot decide: an exact point of an
 // edge between full-mantissa endpoints far from the origin (the interval
 // products are inexact, so no filter can certify the zero), and the points
-// one and two ulps around it; compared against the rationals, with the
-// exact fallback counted.
+// one and two ulps around it; compared against the rationals. With the ray
+// as built, the doubles of each edge function share a grid of at most 61
+// bits and the 256-bit determinant settles every exact edge hit without
+// GMP; with d scaled by 2^40 (the same rays: t scales by 2^-40) they span
+// more and every exact edge hit takes the GMP path. Both are checked.
 TEST(OracleReference, UlpsAroundAnEdgePointTakeTheExactPath) {
-  std::mt19937_64 g(10);
-  std::uniform_real_distribution<double> u(-1, 1);
-  unsigned long long on_edge = 0, fallbacks = 0;
-  for (double off : {1.0, 1e3, 1e6, 148376.0}) {
-    for (int i = 0; i < 20; ++i) {
-      const Vec3d P = Vec3d{off, -off / 3, off * 0.7} + Vec3d{u(g), u(g), u(g)};
-      // a, b = P -+ h with h a multiple of ulp(P) so that P is exactly their midpoint.
-      Vec3d h;
-      for (int k = 0; k < 3; ++k) h[k] = std::ldexp(std::round(u(g) * 1024), std::ilogb(P[k]) - 52 + 30);
-      const Vec3d a = P - h, b = P + h, c = P + Vec3d{u(g), u(g), u(g)};
-      if (!(P - a == h && b - P == h)) continue;
-      const Vec3d o = P + Vec3d{u(g), u(g), 2 + u(g)};
-      const Vec3d d = P - o;
-      if (!(o + d == P && P - d == o)) continue;  // want d exact
-      for (int dx = -2; dx <= 2; ++dx) {
-        Vec3d t = P;
-        for (int k = 0; k < std::abs(dx); ++k) t.x = std::nextafter(t.x, dx > 0 ? 1e300 : -1e300);
-        const Rayd r{o, t - o};
-        SCOPED_TRACE("offset " + std::to_string(off) + " case " + std::to_string(i) + " ulps " + std::to_string(dx));
-        const auto before = ra::oracle::exact_fallbacks();
-        const auto want = ref_triangle(r, a, b, c);
-        expect_same(ra::oracle::triangle(r, a, b, c), want);
-        if (dx == 0) {
-          EXPECT_EQ(want.verdict, Verdict::boundary);
-          on_edge += 1;
-          fallbacks += ra::oracle::exact_fallbacks() - before;
+  for (const double scale : {1.0, 0x1p40}) {
+    SCOPED_TRACE("d scaled by " + std::to_string(scale));
+    std::mt19937_64 g(10);
+    std::uniform_real_distribution<double> u(-1, 1);
+    unsigned long long on_edge = 0, fallbacks = 0;
+    for (double off : {1.0, 1e3, 1e6, 148376.0}) {
+      for (int i = 0; i < 20; ++i) {
+        const Vec3d P = Vec3d{off, -off / 3, off * 0.7} + Vec3d{u(g), u(g), u(g)};
+        // a, b = P -+ h with h a multiple of ulp(P) so that P is exactly their midpoint.
+        Vec3d h;
+        for (int k = 0; k < 3; ++k) h[k] = std::ldexp(std::round(u(g) * 1024), std::ilogb(P[k]) - 52 + 30);
+        const Vec3d a = P - h, b = P + h, c = P + Vec3d{u(g), u(g), u(g)};
+        if (!(P - a == h && b - P == h)) continue;
+        const Vec3d o = P + Vec3d{u(g), u(g), 2 + u(g)};
+        const Vec3d d = P - o;
+        if (!(o + d == P && P - d == o)) continue;  // want d exact
+        for (int dx = -2; dx <= 2; ++dx) {
+          Vec3d t = P;
+          for (int k = 0; k < std::abs(dx); ++k) t.x = std::nextafter(t.x, dx > 0 ? 1e300 : -1e300);
+          const Rayd r{o, (t - o) * scale};
+          SCOPED_TRACE("offset " + std::to_string(off) + " case " + std::to_string(i) + " ulps " + std::to_string(dx));
+          const auto before = ra::oracle::exact_fallbacks();
+          const auto want = ref_triangle(r, a, b, c);
+          expect_same(ra::oracle::triangle(r, a, b, c), want);
+          if (dx == 0) {
+            EXPECT_EQ(want.verdict, Verdict::boundary);
+            on_edge += 1;
+            fallbacks += ra::oracle::exact_fallbacks() - before;
+          }
         }
       }
     }
+    EXPECT_GT(on_edge, 40u);
+    EXPECT_EQ(fallbacks, scale == 1.0 ? 0u : on_edge);
   }
-  EXPECT_GT(on_edge, 40u);
-  EXPECT_EQ(fallbacks, on_edge);  // every exact edge hit needed the exact path
 }
 
 // ---------------------------------------------------- sphere reference ---
