@@ -117,7 +117,8 @@ void setup(CLI::App& app) {
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--threads", args->threads, "Threads for our render (default: all cores)")->check(CLI::Range(0, 1024));
   cmd->add_flag("--explain", args->explain,
-                "Test each differing pixel for the known causes (float32 mesh data, POV's shadow cache)");
+                "Test each differing pixel for the known causes (float32 mesh data, equal-normal triangles, "
+                "POV's mesh2 hit point, its shadow cache)");
   cmd->add_flag("--keep-pov-dir", args->keep, "Keep POV-Ray's working directory (scene.pov, ini, images)");
   cmd->add_flag("--skip-inexpressible", args->skip_inexpressible,
                 "Exit 77 (a skip for ctest) with the reason when POV-Ray cannot express the scene or a ${cache} "

@@ -15,6 +15,7 @@
 #include "bvh.h"
 #include "camera.h"
 #include "errors.h"
+#include "pov_mesh.h"
 #include "registry.h"
 #include "texture.h"
 
@@ -348,11 +349,18 @@ struct Tracer::Impl {
         const Vec3d& a = set.positions[tri.v[0]];
         const Vec3d& b = set.positions[tri.v[1]];
         const Vec3d& c = set.positions[tri.v[2]];
-        const double b0 = 1 - h.b1 - h.b2;
+        double b1 = h.b1, b2 = h.b2;
         // The hit point from the barycentrics lies on the triangle's plane
         // (o + t d may not, by t's rounding).
-        s.p = a * b0 + b * h.b1 + c * h.b2;
-        s.p_error = triangle_point_error(a, b, c, h.b1, h.b2);
+        s.p = a * (1 - b1 - b2) + b * b1 + c * b2;
+        s.p_error = triangle_point_error(a, b, c, b1, b2);
+        if (opt.pov_mesh_hit)
+          if (const PovMeshHit ph = pov_mesh_hit(ray, a, b, c); ph.ok) {
+            s.p = ph.p;
+            b1 = ph.b1;
+            b2 = ph.b2;
+          }
+        const double b0 = 1 - b1 - b2;
         const auto& gn = opt.use_double ? meshes_d[mesh_index[h.object]].gnormal[h.prim]
                                         : meshes_f[mesh_index[h.object]].gnormal[h.prim];
         s.ng = gn;
@@ -362,11 +370,11 @@ struct Tracer::Impl {
           if (tri.n[0] >= 0 && tri.n[1] >= 0 && tri.n[2] >= 0) {
             // Document 002: n = normalize(nA + l2 (nB - nA) + l3 (nC - nA)).
             const Vec3d& na = set.normals[tri.n[0]];
-            n = na + (set.normals[tri.n[1]] - na) * h.b1 + (set.normals[tri.n[2]] - na) * h.b2;
+            n = na + (set.normals[tri.n[1]] - na) * b1 + (set.normals[tri.n[2]] - na) * b2;
           } else {
             const auto& vn = opt.use_double ? meshes_d[mesh_index[h.object]].vertex_normal
                                             : meshes_f[mesh_index[h.object]].vertex_normal;
-            n = vn[tri.v[0]] * b0 + vn[tri.v[1]] * h.b1 + vn[tri.v[2]] * h.b2;
+            n = vn[tri.v[0]] * b0 + vn[tri.v[1]] * b1 + vn[tri.v[2]] * b2;
           }
           const double len = length(n);
           if (len > 0) s.n = n / len;
@@ -376,8 +384,8 @@ struct Tracer::Impl {
           const auto& tb = set.uvs[tri.t[1]];
           const auto& tc = set.uvs[tri.t[2]];
           s.has_uv = true;
-          s.u = ta[0] + (tb[0] - ta[0]) * h.b1 + (tc[0] - ta[0]) * h.b2;
-          s.v = ta[1] + (tb[1] - ta[1]) * h.b1 + (tc[1] - ta[1]) * h.b2;
+          s.u = ta[0] + (tb[0] - ta[0]) * b1 + (tc[0] - ta[0]) * b2;
+          s.v = ta[1] + (tb[1] - ta[1]) * b1 + (tc[1] - ta[1]) * b2;
         }
         s.material = &set.materials[std::clamp(tri.material, 0, int(set.materials.size()) - 1)];
         if (s.has_uv && s.material->bump)

@@ -25,6 +25,12 @@ struct RenderOptions {
   int threads = 0;          // 0: all cores
   int samples_per_axis = 1; // n x n samples per pixel, averaged
   bool progress = true;     // a progress line on a terminal (stderr)
+  // Shade a mesh hit where POV-Ray 3.7's mesh2 puts it (renderer/pov_mesh.h):
+  // the point O + t D with t from the triangle's float32 plane, and normals
+  // and UVs interpolated there through POV's float32 Perp vector. Which
+  // triangle is hit is still decided by the triangle method. A hypothesis for
+  // rayaudit compare --explain, not a way to render.
+  bool pov_mesh_hit = false;
 };
 
 // What a ray hit: object index, primitive (triangle) index, t and the

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "camera.h"
+#include "pov_mesh.h"
 #include "spawn.h"
 
 namespace ra {
@@ -19,13 +20,30 @@ Scene as_pov_stores_it(const Scene& scene, bool float32, bool flatten) {
   for (auto& o : s.objects) {
     if (o.kind != Object::Kind::mesh) continue;
     auto set = std::make_shared<TriangleSet>(*o.mesh);
+    if (float32 && set->shading == Shading::smooth) {
+      // Triangles without vn: the exporter hands POV the area-weighted vertex
+      // normals of the unrounded vertices (pov_export.cpp), so do the same
+      // here before rounding; left to the renderer, they would come from the
+      // float32 vertices and never be rounded themselves.
+      bool need_computed = false;
+      for (const auto& tri : set->triangles) need_computed |= tri.n[0] < 0 || tri.n[1] < 0 || tri.n[2] < 0;
+      if (need_computed) {
+        const int base = int(set->normals.size());
+        const auto vn = area_weighted_vertex_normals(*set);
+        set->normals.insert(set->normals.end(), vn.begin(), vn.end());
+        for (auto& tri : set->triangles)
+          if (tri.n[0] < 0 || tri.n[1] < 0 || tri.n[2] < 0) tri.n = {base + tri.v[0], base + tri.v[1], base + tri.v[2]};
+      }
+    }
     if (float32) {
-      for (auto& p : set->positions) p = Vec3d(Vec3f(p));
+      // to_float32, not Vec3d(Vec3f(p)): GCC 12.2 drops that rounding in x
+      // and y (renderer/pov_mesh.h).
+      for (auto& p : set->positions) p = to_float32(p);
       for (auto& n : set->normals) {
         const double len = length(n);
-        if (len > 0) n = Vec3d(Vec3f(n / len));
+        if (len > 0) n = to_float32(n / len);
       }
-      for (auto& uv : set->uvs) uv = {double(float(uv[0])), double(float(uv[1]))};
+      for (auto& uv : set->uvs) uv = {to_float32(uv[0]), to_float32(uv[1])};
     }
     if (flatten && set->shading == Shading::smooth) {
       for (auto& tri : set->triangles) {
@@ -55,20 +73,28 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
   if (c.differences.empty()) return out;
   RenderOptions quiet = options;
   quiet.progress = false;
+  RenderOptions pov_hit = quiet;
+  pov_hit.pov_mesh_hit = true;
   struct Model {
     const char* cause;
     Scene scene;
+    RenderOptions options;
   };
   const Model models[] = {
       {"float32: with the mesh's vertices, normals and UVs rounded to float32, as POV-Ray's mesh2 stores them, "
        "our pixel equals POV-Ray's",
-       as_pov_stores_it(scene, true, false)},
+       as_pov_stores_it(scene, true, false), quiet},
       {"equal normals: POV-Ray makes a triangle whose three normals are equal flat, with the normal of its "
        "vertices rather than the given one; done so (and with float32 mesh data), our pixel equals POV-Ray's",
-       as_pov_stores_it(scene, true, true)},
+       as_pov_stores_it(scene, true, true), quiet},
+      {"mesh2 hit point: POV-Ray puts the hit at O + t D with t from the triangle's plane stored as float32 (its "
+       "unit normal and distance), off the plane of the vertices, and interpolates the smooth normal there "
+       "through its float32 Perp vector (shape/mesh.cpp); done so (with float32 mesh data and equal normals "
+       "flat), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_hit},
   };
   std::vector<std::unique_ptr<Tracer>> model_tracers;
-  for (const auto& m : models) model_tracers.push_back(std::make_unique<Tracer>(m.scene, quiet));
+  for (const auto& m : models) model_tracers.push_back(std::make_unique<Tracer>(m.scene, m.options));
   const Tracer tracer(scene, quiet);
   const Camera camera(scene.camera, scene.width, scene.height);
   const unsigned m = c.bits == 16 ? 65535u : 255u;

@@ -1,0 +1,48 @@
+// POV-Ray 3.7's own mesh2 arithmetic (source/backend/shape/mesh.cpp and the
+// parser's Parse_Mesh2, v3.7.0.10), for validation/pov_explain's hypotheses:
+// where POV puts the hit point of a ray on a triangle and at which
+// barycentrics it interpolates the triangle's smooth normals there.
+//
+// POV keeps, per triangle of a mesh2, everything in float32: the vertices,
+// the normals (normalised, then rounded), the unit plane normal
+// S = (C - A) x (B - A) and the plane's distance D = -S.A (computed in double
+// from the float vertices, then rounded). A ray meets the plane at
+//   t = -(D + S.O) / (S.Dir)           (double, with the float S and D)
+// and the hit point is O + t Dir: not on the plane of the float vertices but
+// off it by D's and S's rounding, ~1e-7 at unit scale, i.e. ~1e-7 / |cos| along
+// the ray. The smooth normal is interpolated at that point through the float
+// vector `Perp` of compute_smooth_triangle (after the vertex swap of
+// Compute_Mesh_Triangle): u = (P - P1).Perp, and below 1e-10 the normal is
+// N1's alone.
+//
+// Where the smooth normals vary fast (small triangles on a curved surface),
+// that moves N.L by 1e-6 to 1e-4, enough to cross an 8-bit rounding boundary:
+// measured on corpus/ladder-100k-bunny (scenes/corpus/pov/).
+#pragma once
+#include "ray.h"
+#include "vec.h"
+
+namespace ra {
+
+// v rounded to float32 and back. Through a volatile float: GCC 12.2 at -O2
+// and -O3 compiles Vec3d(Vec3f(p)) to p unchanged in x and y when it
+// SLP-vectorises the pair (seen on Debian 12's g++ 12.2.0), which silently
+// skips the very rounding these hypotheses are about.
+inline double to_float32(double v) {
+  volatile float f = float(v);
+  return f;
+}
+inline Vec3d to_float32(const Vec3d& v) { return {to_float32(v.x), to_float32(v.y), to_float32(v.z)}; }
+
+struct PovMeshHit {
+  Vec3d p;            // O + t Dir, t from POV's float32 plane
+  double b1 = 0, b2 = 0;  // POV's weights of b and c at p (a has 1 - b1 - b2)
+  bool ok = false;    // false: the ray is parallel to the plane (|S.Dir| < 1e-10)
+};
+
+// The hit of ray r on triangle (a, b, c), listed in that order in the mesh2's
+// face_indices, as POV-Ray computes it. The vertices are rounded to float32
+// here (as POV stores them). The triangle must not be degenerate.
+PovMeshHit pov_mesh_hit(const Ray<double>& r, const Vec3d& a, const Vec3d& b, const Vec3d& c);
+
+}  // namespace ra
