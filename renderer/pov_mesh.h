@@ -24,16 +24,6 @@
 
 namespace ra {
 
-// v rounded to float32 and back. Through a volatile float: GCC 12.2 at -O2
-// and -O3 compiles Vec3d(Vec3f(p)) to p unchanged in x and y when it
-// SLP-vectorises the pair (seen on Debian 12's g++ 12.2.0), which silently
-// skips the very rounding these hypotheses are about.
-inline double to_float32(double v) {
-  volatile float f = float(v);
-  return f;
-}
-inline Vec3d to_float32(const Vec3d& v) { return {to_float32(v.x), to_float32(v.y), to_float32(v.z)}; }
-
 struct PovMeshHit {
   Vec3d p;            // O + t Dir, t from POV's float32 plane
   double b1 = 0, b2 = 0;  // POV's weights of b and c at p (a has 1 - b1 - b2)

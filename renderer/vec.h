@@ -55,4 +55,14 @@ template <class T> std::ostream& operator<<(std::ostream& os, const Vec3<T>& v) 
 using Vec3f = Vec3<float>;
 using Vec3d = Vec3<double>;
 
+// x rounded to float and back, through a volatile float: GCC 12.2 (Debian
+// 12's g++ 12.2.0) at -O2 and -O3 compiles a vectorised pair of
+// double(float(x)) to x unchanged, silently skipping the rounding. Use this
+// wherever a double must hold exactly what a float computation would see.
+inline double to_float32(double x) {
+  volatile float f = float(x);
+  return f;
+}
+inline Vec3<double> to_float32(const Vec3<double>& v) { return {to_float32(v.x), to_float32(v.y), to_float32(v.z)}; }
+
 }  // namespace ra

@@ -138,8 +138,9 @@ const Mesh& closed_mesh(int shape) {
 }
 
 // --------------------------------------------------------- rounding ---
-Vec3d to_float(const Vec3d& v) { return Vec3d(Vec3<float>(v)); }
-double to_float(double x) { return double(float(x)); }
+// to_float32 (vec.h), not Vec3d(Vec3f(v)): GCC 12.2 can drop that rounding.
+Vec3d to_float(const Vec3d& v) { return to_float32(v); }
+double to_float(double x) { return to_float32(x); }
 void round_to_float(TriangleBatch& b, std::size_t tri0, std::size_t probe0) {
   for (std::size_t i = tri0; i < b.tris.size(); ++i)
     b.tris[i] = {to_float(b.tris[i].a), to_float(b.tris[i].b), to_float(b.tris[i].c)};
