@@ -10,6 +10,7 @@
 #include <cstring>
 #include <map>
 #include <thread>
+#include <type_traits>
 
 #include "bump.h"
 #include "bvh.h"
@@ -335,12 +336,10 @@ struct Tracer::Impl {
     switch (o.kind) {
       case Object::Kind::sphere:
         s.ng = s.n = (s.p - o.sphere.center) / o.sphere.radius;
-        s.p_error = sphere_point_error(s.p - o.sphere.center) + abs(o.sphere.center) * detail::gamma<double>(1);
         s.material = &o.material;
         break;
       case Object::Kind::plane:
         s.ng = s.n = o.plane.normal;
-        s.p_error = abs(s.p) * detail::gamma<double>(7);
         s.material = &o.material;
         break;
       case Object::Kind::mesh: {
@@ -353,7 +352,6 @@ struct Tracer::Impl {
         // The hit point from the barycentrics lies on the triangle's plane
         // (o + t d may not, by t's rounding).
         s.p = a * (1 - b1 - b2) + b * b1 + c * b2;
-        s.p_error = triangle_point_error(a, b, c, b1, b2);
         if (opt.pov_mesh_hit)
           if (const PovMeshHit ph = pov_mesh_hit(ray, a, b, c); ph.ok) {
             s.p = ph.p;
@@ -393,32 +391,35 @@ struct Tracer::Impl {
         break;
       }
     }
-    if (!opt.use_double) s.p_error = float_point_error(o, h, s.p);
+    s.p_error = opt.use_double ? point_error<double>(o, h, s.p) : point_error<float>(o, h, s.p);
     return s;
   }
 
-  // In float the secondary ray starts at Vec3f(p): the error bound must be
-  // float's (gamma(n) with float's epsilon, not double's), plus the rounding
-  // of p to float, or normal-offset moves the origin by far too little.
-  Vec3d float_point_error(const Object& o, const SceneHit& h, const Vec3d& p) const {
+  // A bound on |p - exact hit point| per component (pbrt-v4), in the
+  // precision T the secondary ray is spawned in: gamma(n) with T's epsilon.
+  // In float the ray starts at Vec3f(p), so p's rounding to float is added;
+  // with double's bound normal-offset would move it by far too little.
+  template <class T>
+  Vec3d point_error(const Object& o, const SceneHit& h, const Vec3d& p) const {
     using detail::gamma;
-    Vec3f e;
+    Vec3<T> e;
     switch (o.kind) {
       case Object::Kind::sphere:
-        e = sphere_point_error(Vec3f(p - o.sphere.center)) + abs(Vec3f(o.sphere.center)) * gamma<float>(1);
+        e = sphere_point_error(Vec3<T>(p - o.sphere.center)) + abs(Vec3<T>(o.sphere.center)) * gamma<T>(1);
         break;
       case Object::Kind::plane:
-        e = abs(Vec3f(p)) * gamma<float>(7);
+        e = abs(Vec3<T>(p)) * gamma<T>(7);
         break;
       case Object::Kind::mesh: {
         const TriangleSet& set = *o.mesh;
         const MeshTriangle3& tri = set.triangles[h.prim];
-        e = triangle_point_error(Vec3f(set.positions[tri.v[0]]), Vec3f(set.positions[tri.v[1]]),
-                                 Vec3f(set.positions[tri.v[2]]), float(h.b1), float(h.b2));
+        e = triangle_point_error(Vec3<T>(set.positions[tri.v[0]]), Vec3<T>(set.positions[tri.v[1]]),
+                                 Vec3<T>(set.positions[tri.v[2]]), T(h.b1), T(h.b2));
         break;
       }
     }
-    return Vec3d(e + abs(Vec3f(p)) * gamma<float>(1));
+    if constexpr (std::is_same_v<T, float>) e = e + abs(Vec3f(p)) * gamma<float>(1);
+    return Vec3d(e);
   }
 
   // The pigment: the texture at (u, v) where the surface has UVs, else the
