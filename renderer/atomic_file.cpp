@@ -66,15 +66,7 @@ bool OutputBatch::stage(const std::filesystem::path& path, const std::filesystem
   const auto k = key(path);
   for (const auto& o : b->outputs_)
     if (o == k) {
-      // The same output written twice: the later file wins.
-      for (auto& [t, f] : b->staged_)
-        if (f == k) {
-          std::error_code ec;
-          std::filesystem::remove(t, ec);
-          t = tmp;
-          return true;
-        }
-      b->staged_.emplace_back(tmp, k);
+      b->staged_.emplace_back(tmp, k);  // renamed in order: a file written twice ends as the later one
       return true;
     }
   return false;
