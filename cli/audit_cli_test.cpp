@@ -174,9 +174,13 @@ TEST(AuditCli, AbsurdCountsAndIgnoredOptionsAreUsageErrors) {
   // Options that would be silently ignored.
   const fs::path csv = tmp("ok.csv");
   write(csv, kHeader + "0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
-  EXPECT_EQ(rayaudit("audit --cases " + csv.string() + " --csv " + tmp("z.csv").string()).code, 2);
-  EXPECT_EQ(rayaudit("audit --export-cases " + tmp("e.csv").string() + " --families edge --rays 5 --json " +
-                     tmp("e.json").string()).code, 2);
+  r = rayaudit("audit --cases " + csv.string() + " --csv " + tmp("z.csv").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--csv"), std::string::npos) << r.err;
+  r = rayaudit("audit --export-cases " + tmp("e.csv").string() + " --families edge --rays 5 --json " +
+               tmp("e.json").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--json"), std::string::npos) << r.err;
   // A family none of the chosen methods can grade.
   r = rayaudit("audit --methods kraus --families edge --rays 10");
   EXPECT_EQ(r.code, 2);

@@ -105,19 +105,30 @@ TEST(Cli, MethodsJsonListsEightTriangleFourSphereAndOnePlaneMethod) {
 }
 
 // Every method by name, in both precisions, with culling: each render
-// succeeds and writes its image. `--method NAME` may come before SCENE.
+// succeeds and writes an image of the asked size in which something was hit
+// (not one uniform colour). Triangle methods render the doc002 tetrahedron
+// (a mesh), sphere methods the sphere on a plane. `--method NAME` may come
+// before SCENE.
 TEST(Cli, RendersWithEveryMethodInBothPrecisionsAndWithCulling) {
   const fs::path dir = temp_dir();
   const std::string scene = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/sphere-on-plane.json";
-  std::vector<std::string> names = kTriangleMethods;
-  names.insert(names.end(), kSphereMethods.begin(), kSphereMethods.end());
-  for (const auto& name : names)
+  const std::string mesh_scene = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/doc002-tetrahedron.json";
+  std::vector<std::pair<std::string, std::string>> cases;  // method, scene
+  for (const auto& name : kTriangleMethods) cases.emplace_back(name, mesh_scene);
+  for (const auto& name : kSphereMethods) cases.emplace_back(name, scene);
+  for (const auto& [name, scene_file] : cases)
     for (const char* precision : {"float", "double"}) {
       const fs::path out = dir / (name + "-" + precision + ".png");
-      const Result r = run("render --method " + name + " " + scene + " -o " + out.string() +
+      const Result r = run("render --method " + name + " " + scene_file + " -o " + out.string() +
                            " --width 32 --height 24 --cull --precision " + precision);
       EXPECT_EQ(r.code, 0) << name << " " << precision << ": " << r.out;
-      EXPECT_TRUE(fs::exists(out)) << out;
+      ASSERT_TRUE(fs::exists(out)) << out;
+      const ra::Image img = ra::read_image(out);
+      EXPECT_EQ(img.width, 32);
+      EXPECT_EQ(img.height, 24);
+      bool uniform = true;
+      for (std::size_t i = 3; i < img.rgb.size(); ++i) uniform = uniform && img.rgb[i] == img.rgb[i % 3];
+      EXPECT_FALSE(uniform) << name << " " << precision << ": nothing was hit";
     }
   const Result two = run("render " + scene + " -o " + (dir / "two.png").string() +
                          " --method kraus --method stable");

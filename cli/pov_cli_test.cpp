@@ -123,6 +123,7 @@ TEST(CompareCli, OneUnwritableOutputMeansNoOutputAtAll) {
   Result r = run("compare " + kSphereOnPlane + " --width 40 --height 30 --json /nonexistent/c.json --diff " +
                  (dir / "d.png").string() + " --ours " + (dir / "o.png").string());
   EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("/nonexistent/c.json: output directory does not exist"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::is_empty(dir)) << "compare wrote outputs though --json could not be written";
   // A tolerance file named on the command line must exist.
   r = run("compare " + kSphereOnPlane + " --width 40 --height 30 --tolerance " + (dir / "none.json").string());
@@ -136,6 +137,7 @@ TEST(ExportPovCli, OneUnwritableOutputMeansNoOutputAtAll) {
   const std::string textured = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/teapot-textured.json";
   Result r = run("export-pov " + textured + " -o " + (dir / "t.pov").string() + " --ini /nonexistent/t.ini");
   EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("/nonexistent/t.ini: output directory does not exist"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::is_empty(dir)) << "export-pov wrote the .pov or its textures though the ini could not be written";
   r = run("export-pov " + textured + " -o " + (dir / "t.pov").string() + " --ini " + (dir / "t.ini").string());
   ASSERT_EQ(r.code, 0) << r.out;

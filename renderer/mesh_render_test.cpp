@@ -268,7 +268,7 @@ TEST(Texture, BilinearWrapsAtTheBorders) {
 //  nearest  (0.1, 0.1): x 0.4, y 1.8 -> texel (0, 1) = (20, 150, 7) (v = 0 is the bottom row)
 //           (0.9, 0.9): x 3.6, y 0.2 -> texel (3, 0) = (140, 50, 7)
 //           (1.1, -0.9) repeats (0.1, 0.1); (-0.1, 0.9) repeats (0.9, 0.9)
-//  bilinear (0.4375, 0.625): x + 0.5 = 2.25, y + 0.5 = 1.25: 1/4 of column 2 and
+//  bilinear (0.4375, 0.625): x - 0.5 = 1.25, y - 0.5 = 0.25: 1/4 of column 2 and
 //           3/4 of column 1, 1/4 of row 1 and 3/4 of row 0:
 //           R = 100/4 + 3*60/4 = 70, G = 150/4 + 3*50/4 = 75
 //           (0, 0): halfway between columns 0 and 3 and rows 1 and 0 (wrapping):
@@ -635,7 +635,7 @@ TEST(Cull, OnlyClosedOutwardMeshesAreCulled) {
 
 // --cull really skips back faces of a closed mesh (a ray from inside the
 // ball sees only back faces) and is not applied to an open one (the same ray
-// inside an open hemisphere-like quad pair still hits).
+// seeing the back of an open mesh, a single quad, still hits it).
 TEST(Cull, SkipsBackFacesOfClosedMeshesOnly) {
   const auto dir = temp_dir();
   write_text(dir / "ball.obj", uv_sphere_obj(8, 12, false));

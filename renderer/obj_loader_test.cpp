@@ -296,6 +296,7 @@ TEST(ObjText, NoTrailingNewlineKeepsTheLastLine) {
   const Mesh n = load_text(d, std::string(kTri) + "f 1 2 3\nusemtl last\n");  // the same with a newline
   ASSERT_EQ(n.materials.size(), 1u);
   EXPECT_EQ(n.materials[0].name, "last");
+  ASSERT_EQ(n.triangles.size(), 1u);
   EXPECT_EQ(n.triangles[0].material, -1);  // set after the only face
 }
 
@@ -571,21 +572,18 @@ TEST(ObjErrors, IndexErrorsNameTheFaceLine) {
 // the whole file has.
 TEST(ObjErrors, ForwardReferenceAndNeverDefinedAreTold) {
   const std::string t = kTri;
+  auto forward = [](int face_line, const char* kind, int index, int defined_line, int before) {
+    return "t.obj:" + std::to_string(face_line) + ": " + kind + " index " + std::to_string(index) +
+           " is defined later, at line " + std::to_string(defined_line) +
+           ": forward references are not allowed (" + std::to_string(before) + " defined before this face)";
+  };
   // vertex 4 is the `v` on line 6 (line 5 is a vt, which does not count).
-  EXPECT_EQ(load_error(t + "f 1 2 4\nvt 0 0\nv 1 1 1\n"),
-            "t.obj:4: vertex index 4 is defined later, at line 6: forward references are not allowed (3 defined "
-            "before this face)");
+  EXPECT_EQ(load_error(t + "f 1 2 4\nvt 0 0\nv 1 1 1\n"), forward(4, "vertex", 4, 6, 3));
   // the face spans lines 4-5 (continuation); vertex 5 is on line 8, after a
   // continued `v` on lines 6-7 (vertex 4).
-  EXPECT_EQ(load_error(t + "f 1 2 \\\n5\nv 1 \\\n1 1\nv 2 2 2\n"),
-            "t.obj:4: vertex index 5 is defined later, at line 8: forward references are not allowed (3 defined "
-            "before this face)");
-  EXPECT_EQ(load_error(t + "f 1/1 2/1 3/2\nvt 0 0\nvt 1 1\n"),
-            "t.obj:4: texture index 1 is defined later, at line 5: forward references are not allowed (0 defined "
-            "before this face)");
-  EXPECT_EQ(load_error(t + "vn 0 0 1\nf 1//1 2//1 3//2\nvn 0 0 1\n"),
-            "t.obj:5: normal index 2 is defined later, at line 6: forward references are not allowed (1 defined "
-            "before this face)");
+  EXPECT_EQ(load_error(t + "f 1 2 \\\n5\nv 1 \\\n1 1\nv 2 2 2\n"), forward(4, "vertex", 5, 8, 3));
+  EXPECT_EQ(load_error(t + "f 1/1 2/1 3/2\nvt 0 0\nvt 1 1\n"), forward(4, "texture", 1, 5, 0));
+  EXPECT_EQ(load_error(t + "vn 0 0 1\nf 1//1 2//1 3//2\nvn 0 0 1\n"), forward(5, "normal", 2, 6, 1));
   // Never defined: the count is the whole file's (4 v, one after the face).
   EXPECT_EQ(load_error(t + "f 1 2 9\nv 1 1 1\n"), "t.obj:4: vertex index 9 is past the end: the file has only 4 vertices");
   EXPECT_EQ(load_error("v 0 0 0\nf 1 1 2\n"), "t.obj:2: vertex index 2 is past the end: the file has only 1 vertex");

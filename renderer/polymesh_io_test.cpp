@@ -79,11 +79,16 @@ TEST(Ply, Errors) {
   // Binary: no lines, so the byte offset after the face's list.
   std::string body = binary_body(false);
   body[body.size() - 13 - 4] = 9;  // the quad's last index (the triangle takes the last 13 bytes), little endian
+  const std::string head = std::string("ply\nformat binary_little_endian 1.0\n") + kHeader;
   try {
-    parse_ply(std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + body, "b.ply");
+    parse_ply(head + body, "b.ply");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("b.ply: byte "), std::string::npos) << e.what();
+    // Offsets count from the start of the file, and the quad ends where the
+    // triangle's 13 bytes begin.
+    EXPECT_NE(std::string(e.what()).find("b.ply: byte " + std::to_string(head.size() + body.size() - 13) + ": face 0"),
+              std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("face 0 has vertex index 9 out of range"), std::string::npos) << e.what();
   }
 }

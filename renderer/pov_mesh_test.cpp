@@ -75,6 +75,10 @@ TEST(PovMesh, BunnyPixelOnTheVertexPlaneDoesNotMatch) {
   EXPECT_GT(std::fabs(p.z - kPovHitZ), 1e-7);
   EXPECT_GT(std::fabs(s.n_dot_l(p, b1, b2) - kPovNdotL), 3e-6);
   EXPECT_GT((0.08 + 0.64 * s.n_dot_l(p, b1, b2)) * 255, 67.5);
+  // And pov_mesh_hit is not that point: it moves the hit off the vertex plane.
+  const PovMeshHit h = pov_mesh_hit(s.ray, s.a, s.b, s.c);
+  ASSERT_TRUE(h.ok);
+  EXPECT_GT(std::fabs(h.p.z - p.z), 1e-7);
 }
 
 TEST(PovMesh, WeightsDoNotDependOnTheVertexSwap) {

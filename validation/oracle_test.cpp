@@ -327,6 +327,7 @@ TEST(OracleReference, ExactEdgeHitsAtLargeOffsets) {
       const auto got = ra::oracle::triangle(r, a, b, c);
       const auto want = ref_triangle(r, a, b, c);
       expect_same(got, want);
+      EXPECT_EQ(want.verdict, Verdict::boundary);  // aimed at the exact midpoint of edge ab
       if (want.verdict == Verdict::boundary) {
         EXPECT_EQ(want.zero_edges, 1);
         EXPECT_EQ(got.t, 1.0);
@@ -597,6 +598,18 @@ void check_sph(const SphCase& k, int& decided, int& fell_back) {
 // Windows that end at the rounded crossing t or one ulp either side of it (the
 // exact crossing is never a double here, so each is a clear hit or miss that
 // only the sign of N - x D, or of root - x, decides).
+std::vector<std::pair<double, double>> windows_around(double t);
+
+// Checks k with its ray's window set to each of windows_around(t).
+template <class Case, class Check>
+void check_windows(const Case& k, double t, Check check) {
+  for (const auto& [lo, hi] : windows_around(t)) {
+    Case w = k;
+    w.r.tmin = lo, w.r.tmax = hi;
+    check(w);
+  }
+}
+
 std::vector<std::pair<double, double>> windows_around(double t) {
   const double inf = std::numeric_limits<double>::infinity();
   const double below = std::nextafter(t, -inf), above = std::nextafter(t, inf);
@@ -743,11 +756,8 @@ TEST(OracleDD, TriangleTOnAndNextToAMidpointOrADouble) {
           SCOPED_TRACE("o[" + std::to_string(k) + "] moved by 2^-" + std::to_string(j) + " |P|");
           check_tri(v, decided, fell_back);
           if (on_double && k == 0 && (j == 94 || j == 100 || j == 106)) {
-            for (const auto& [lo, hi] : windows_around(ref_triangle(v.r, a, b, c).t)) {
-              TriCase w = v;
-              w.r.tmin = lo, w.r.tmax = hi;
-              check_tri(w, decided, fell_back);
-            }
+            check_windows(v, ref_triangle(v.r, a, b, c).t,
+                          [&](const TriCase& w) { check_tri(w, decided, fell_back); });
           }
         }
   }
@@ -850,11 +860,7 @@ TEST(OracleDD, SphereRootsOnAndNextToAMidpointOrADouble) {
         if (on_double && (k == 6 || k == 8 || k == 10)) {
           const auto want = ref_sphere(t.r, t.c, t.radius);
           for (double x : {want.t, want.t_far})
-            for (const auto& [lo, hi] : windows_around(x)) {
-              SphCase w = t;
-              w.r.tmin = lo, w.r.tmax = hi;
-              check_sph(w, decided, fell_back);
-            }
+            check_windows(t, x, [&](const SphCase& w) { check_sph(w, decided, fell_back); });
         }
       }
   }
@@ -944,35 +950,44 @@ TEST(OracleDD, ScaledByPowersOfTwoAcrossTheRangeGuard) {
     for (const Vec3d& d : {Vec3d{0, 0, 1}, Vec3d{0x1p-24, 0, 1}, Vec3d{-0x1p-24, 0, 1}})
       sphs.push_back({Rayd{so, d}, ctr, R});
   }
-  auto sv = [](const Vec3d& v, int s) { return Vec3d{std::ldexp(v.x, s), std::ldexp(v.y, s), std::ldexp(v.z, s)}; };
   auto exact = [](const Vec3d& v, int s) {
     return std::ldexp(std::ldexp(v.x, s), -s) == v.x && std::ldexp(std::ldexp(v.y, s), -s) == v.y &&
            std::ldexp(std::ldexp(v.z, s), -s) == v.z;
   };
-  int checked = 0;
+  int checked = 0, decided = 0, fell_back = 0, guard_passed = 0, guard_refused = 0;
   for (int s : {-700, -400, -355, -345, -330, -300, -280, -272, -268, -255, -250, -240, -200, 250, 280, 290, 300,
                 320, 400, 600}) {
-    int decided = 0, fell_back = 0;
     for (std::size_t i = 0; i < tris.size(); ++i) {
       const TriCase& t = tris[i];
       if (!exact(t.r.o, s) || !exact(t.r.d, s) || !exact(t.a, s) || !exact(t.b, s) || !exact(t.c, s)) continue;
       SCOPED_TRACE("2^" + std::to_string(s) + " triangle " + std::to_string(i));
-      const TriCase k{Rayd{sv(t.r.o, s), sv(t.r.d, s)}, sv(t.a, s), sv(t.b, s), sv(t.c, s)};
+      const TriCase k{Rayd{scale(t.r.o, s), scale(t.r.d, s)}, scale(t.a, s), scale(t.b, s), scale(t.c, s)};
       check_tri(k, decided, fell_back);
-      expect_same(ra::oracle::triangle(k.r, k.a, k.b, k.c), ra::oracle::triangle(t.r, t.a, t.b, t.c));
+      const auto before = ra::oracle::exact_fallbacks();
+      const auto got = ra::oracle::triangle(k.r, k.a, k.b, k.c);
+      (ra::oracle::exact_fallbacks() == before ? guard_passed : guard_refused) += 1;
+      expect_same(got, ra::oracle::triangle(t.r, t.a, t.b, t.c));
       ++checked;
     }
     for (std::size_t i = 0; i < sphs.size(); ++i) {
       const SphCase& t = sphs[i];
       if (!exact(t.r.o, s) || !exact(t.r.d, s) || !exact(t.c, s) || !exact({t.radius, 0, 0}, s)) continue;
       SCOPED_TRACE("2^" + std::to_string(s) + " sphere " + std::to_string(i));
-      const SphCase k{Rayd{sv(t.r.o, s), sv(t.r.d, s)}, sv(t.c, s), std::ldexp(t.radius, s)};
+      const SphCase k{Rayd{scale(t.r.o, s), scale(t.r.d, s)}, scale(t.c, s), std::ldexp(t.radius, s)};
       check_sph(k, decided, fell_back);
-      expect_same_sphere(ra::oracle::sphere(k.r, k.c, k.radius), ra::oracle::sphere(t.r, t.c, t.radius));
+      const auto before = ra::oracle::exact_fallbacks();
+      const auto got = ra::oracle::sphere(k.r, k.c, k.radius);
+      (ra::oracle::exact_fallbacks() == before ? guard_passed : guard_refused) += 1;
+      expect_same_sphere(got, ra::oracle::sphere(t.r, t.c, t.radius));
       ++checked;
     }
   }
   EXPECT_GT(checked, 3000);
+  // The scales straddle the range guard: at 2^s some queries stay within it
+  // and are decided by the filters, others fall outside and go to GMP.
+  EXPECT_GT(guard_passed, 0);
+  EXPECT_GT(guard_refused, 0);
+  EXPECT_GT(decided + fell_back, 3000);
 }
 
 // t below 2^-1022: the exact path must round it to the subnormal grid once.

@@ -115,6 +115,15 @@ TYPED_TEST(DocumentMethod, AreasEpsilon5IsADistanceWhateverTheDirectionLength) {
 // rounding makes PBC's Heron product negative, sqrt gives NaN, the comparison
 // is false and the document accepts the point. Every accepted point must be
 // such a NaN case, and some exist in both precisions.
+// Heron's product p(p-a)(p-b)(p-c) as the listing writes it, in T: the
+// cause of the NaN is that it rounds below zero.
+template <class T>
+T heron_product(const Vec3<T>& v1, const Vec3<T>& v2, const Vec3<T>& v3) {
+  const T a = length(v2 - v1), b = length(v3 - v1), c = length(v3 - v2);
+  const T p = (a + b + c) / T(2);
+  return p * (p - a) * (p - b) * (p - c);
+}
+
 TYPED_TEST(DocumentMethod, AreasAcceptsPointsOnAnEdgeLineWhereHeronGivesNaN) {
   using T = TypeParam;
   using V = Vec3<T>;
@@ -125,6 +134,7 @@ TYPED_TEST(DocumentMethod, AreasAcceptsPointsOnAnEdgeLineWhereHeronGivesNaN) {
     if (!hits<T>("areas", r, this->A, this->B, this->C)) continue;
     ++accepted;
     EXPECT_TRUE(std::isnan(areas::area(V{T(1) - s, s, 0}, this->B, this->C))) << "s = " << s;
+    EXPECT_LT(heron_product(V{T(1) - s, s, 0}, this->B, this->C), T(0)) << "s = " << s;
   }
   EXPECT_GT(accepted, 0) << "expected the listing's NaN acceptance to show on this line";
 }
