@@ -7,12 +7,13 @@ PACKAGES=(
   cmake g++ make ninja-build pkg-config
   libcgal-dev libgmp-dev libmpfr-dev
   libopenimageio-dev openimageio-tools
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libbenchmark-tools
   povray
   libembree-dev
   libtinyobjloader-dev
   libcli11-dev nlohmann-json3-dev
   python3-matplotlib python3-numpy
+  chromium
   clang libclang-rt-14-dev
 )
 
