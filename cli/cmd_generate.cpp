@@ -27,6 +27,7 @@
 #include <regex>
 #include <sstream>
 
+#include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "image.h"
@@ -77,6 +78,7 @@ Vec3d eval_patch(const Patch& p, double u, double v) {
 }
 
 void generate_teapot(const std::string& inc, const std::string& out_path, int steps) {
+  ra::check_output_path(out_path);
   const auto patches = read_teapot_inc(inc);
   std::vector<Vec3d> positions;
   std::map<std::array<long long, 3>, int> weld;
@@ -170,8 +172,9 @@ void generate_teapot(const std::string& inc, const std::string& out_path, int st
     if (volume < 0)
       for (int f : component) flip_face(f);
   }
-  std::ofstream out(out_path);
-  if (!out) throw ra::InputError(ra::located(out_path, 0, "cannot write"));
+  // Written through a temporary renamed into place: ci/fetch-corpus.sh takes
+  // an existing teapot.obj for done, so an interrupted run must leave none.
+  std::ostringstream out;
   out.precision(9);
   out << "# Utah teapot: " << patches.size() << " Bezier patches of POV-Ray's teapot.inc, " << steps << "x"
       << steps << " quads each (rayaudit generate teapot)\n";
@@ -180,7 +183,7 @@ void generate_teapot(const std::string& inc, const std::string& out_path, int st
   for (const auto& f : faces)
     out << "f " << f[0] + 1 << '/' << f[1] + 1 << ' ' << f[2] + 1 << '/' << f[3] + 1 << ' ' << f[4] + 1 << '/'
         << f[5] + 1 << '\n';
-  if (!out) throw ra::InputError(ra::located(out_path, 0, "write failed"));
+  ra::write_text_atomically(out_path, out.str());
   std::printf("%s: %zu vertices, %zu triangles\n", out_path.c_str(), positions.size(), faces.size());
 }
 
