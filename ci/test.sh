@@ -4,6 +4,16 @@
 # through ctest, then a 60-second libFuzzer run per parser. Idempotent.
 source "$(dirname "$0")/common.sh"
 
+# In CI (CI set) the corpus is fetched into a new, empty cache on every run,
+# as a newcomer's machine has it: a missing or broken fetch step fails here
+# instead of hiding behind a cache filled by an earlier run.
+if [ -n "${CI:-}" ]; then
+  RAYAUDIT_CACHE="$(mktemp -d "${TMPDIR:-/tmp}/rayaudit-ci-cache.XXXXXX")"
+  export RAYAUDIT_CACHE
+  trap 'rm -rf "$RAYAUDIT_CACHE"' EXIT
+  step "CI is set: a new, empty corpus cache in $RAYAUDIT_CACHE"
+fi
+
 step "fetching the mesh corpus into ${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus (ci/fetch-corpus.sh)"
 ci/fetch-corpus.sh "$RAYAUDIT"
 
