@@ -25,6 +25,7 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 exe="${1:-${RAYAUDIT_EXE:-$here/build/release/rayaudit}}"
+case "$exe" in /*) ;; *) exe="$PWD/$exe" ;; esac  # the script cds into the cache
 cache="${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus"
 mkdir -p "$cache"/{deb,pkg,npm,ladder}
 cd "$cache"
