@@ -331,6 +331,11 @@ struct SweepPlan {
   std::uint64_t first_task;   // tasks of earlier sweep values (this shard's)
   std::uint64_t tasks;        // this shard's chunks of this sweep value
   std::uint64_t per_probe;    // tests per probe, as --rays counts them
+  // Sharded, a sweep value of fewer than 4 n chunks is split by probe (every
+  // shard generates each chunk and keeps probes j with j % n == k - 1), so
+  // small runs split evenly too; larger ones are dealt whole chunks, so no
+  // shard generates what it does not judge.
+  bool by_probe;
 };
 
 struct Chunk {
@@ -338,6 +343,11 @@ struct Chunk {
   std::uint64_t index;  // chunk number within the sweep value
   int count;            // probes in it
 };
+
+// This shard's probes of a sweep value dealt by probe: j < probes, j % n == k - 1.
+std::uint64_t dealt(std::uint64_t probes, Shard s) {
+  return probes > s.k - 1 ? (probes - (s.k - 1) + s.n - 1) / s.n : 0;
+}
 
 struct Plan {
   std::vector<SweepPlan> sweeps;
@@ -348,10 +358,22 @@ struct Plan {
     auto it = std::upper_bound(sweeps.begin(), sweeps.end(), task,
                                [](std::uint64_t t, const SweepPlan& s) { return t < s.first_task; });
     const SweepPlan& sp = *(it - 1);
-    const std::uint64_t c = (task - sp.first_task) * shard.n + (shard.k - 1);
+    const std::uint64_t c = sp.by_probe ? task - sp.first_task : (task - sp.first_task) * shard.n + (shard.k - 1);
     return {&sp, c, int(std::min<long long>(kChunk, sp.probes - (long long)c * kChunk))};
   }
 };
+
+// The probes of chunk c (global index c * kChunk + i) dealt to this shard.
+template <class V> V keep_dealt(const V& all, std::uint64_t c, Shard s) {
+  V out;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if ((c * kChunk + i) % s.n == s.k - 1) out.push_back(all[i]);
+  return out;
+}
+std::uint64_t dealt_in_chunk(const Chunk& ch, Shard s) {
+  const std::uint64_t first = ch.index * kChunk;
+  return dealt(first + std::uint64_t(ch.count), s) - dealt(first, s);
+}
 
 Plan plan(const std::vector<const Family*>& fams, long long rays, Shard shard) {
   Plan pl;
@@ -360,13 +382,20 @@ Plan plan(const std::vector<const Family*>& fams, long long rays, Shard shard) {
     const Family& f = *fams[fi];
     for (int s = 0; s < int(f.sweep.size()); ++s) {
       SweepPlan sp{&f, fi, s, probes_per_sweep(f, s, rays), pl.tasks, 0,
-                   std::uint64_t(f.secondary ? 2 : f.tris_per_probe(s))};
+                   std::uint64_t(f.secondary ? 2 : f.tris_per_probe(s)), false};
       const auto chunks = std::uint64_t((sp.probes + kChunk - 1) / kChunk);
-      sp.tasks = chunks > shard.k - 1 ? (chunks - (shard.k - 1) + shard.n - 1) / shard.n : 0;
+      sp.by_probe = shard.n > 1 && chunks < 4 * shard.n;
+      std::uint64_t probes;
+      if (sp.by_probe) {
+        probes = dealt(std::uint64_t(sp.probes), shard);
+        sp.tasks = probes ? chunks : 0;
+      } else {
+        sp.tasks = dealt(chunks, shard);
+        // This shard's probes: whole chunks, less what the last chunk lacks if it is ours.
+        probes = sp.tasks * kChunk;
+        if (sp.tasks && (chunks - 1) % shard.n == shard.k - 1) probes -= chunks * kChunk - std::uint64_t(sp.probes);
+      }
       if (sp.tasks == 0) continue;
-      // This shard's probes: full chunks, less what the last chunk lacks if it is ours.
-      auto probes = sp.tasks * kChunk;
-      if ((chunks - 1) % shard.n == shard.k - 1) probes -= chunks * kChunk - std::uint64_t(sp.probes);
       pl.tests += probes * sp.per_probe;
       pl.tasks += sp.tasks;
       pl.sweeps.push_back(sp);
@@ -399,9 +428,10 @@ void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const
     const GivenAnswer& g = given[k];
     hits += g.hit;
     if (p == Precision::f32)
-      book<float>(st, ans[std::size_t(k)], g.hit, std::isfinite(float(g.t)), float(g.t));
+      book<float>(st, ans[std::size_t(k)], g.hit, finite_hit(TriangleHit<float>{float(g.t), float(g.u), float(g.v)}),
+                  float(g.t));
     else
-      book<double>(st, ans[std::size_t(k)], g.hit, std::isfinite(g.t), g.t);
+      book<double>(st, ans[std::size_t(k)], g.hit, finite_hit(TriangleHit<double>{g.t, g.u, g.v}), g.t);
   }
   const bool proper = closed || (count > 1 && group_is_proper(tris, count, ray.d));
   book_group(st, count, hits, count > 1 ? crossings(ans.data(), count) : 0, proper);
@@ -507,6 +537,7 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           if (!any) continue;
           TriangleBatch b;
           generate(*t.family, t.sweep, p, stream, t.count, b);
+          if (ch.sweep->by_probe) b.probes = keep_dealt(b.probes, ch.index, shard);
           std::vector<oracle::Answer> ans;
           std::vector<int> cross;
           std::vector<char> proper;
@@ -538,6 +569,7 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           if (!any) continue;
           std::vector<SphereCase> cs;
           generate(*t.family, t.sweep, p, stream, t.count, cs);
+          if (ch.sweep->by_probe) cs = keep_dealt(cs, ch.index, shard);
           std::vector<oracle::Answer> ans;
           for (const auto& c : cs) ans.push_back(oracle::sphere(c.ray, c.center, c.radius));
           for (std::size_t si = 0; si < spheres.size(); ++si) {
@@ -551,7 +583,8 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
       }
       std::lock_guard<std::mutex> lock(mu);
       for (auto& [ci, st] : results) rep.cells[ci].stats.merge(st);
-      done += std::uint64_t(t.count) * ch.sweep->per_probe;
+      const std::uint64_t judged = ch.sweep->by_probe ? dealt_in_chunk(ch, shard) : std::uint64_t(t.count);
+      done += judged * ch.sweep->per_probe;
       if (opt.progress) opt.progress(done, pl.tests);
     }
   };

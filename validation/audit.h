@@ -175,7 +175,7 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
 // verdicts, t errors in ulps of p, leaks and double hits over the group.
 struct GivenAnswer {
   bool hit = false;
-  double t = 0;
+  double t = 0, u = 0, v = 0;  // u, v: barycentrics if given (only checked for NaN/inf)
 };
 void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given,
                  int count, bool closed);

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <tuple>
 #include <unordered_map>
 
 #include "cases_csv.h"
@@ -88,11 +89,9 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
     if (g.answer.hit && ts.empty()) throw InputError(located(path, lineno, "a hit without t (id '" + key + "')"));
     if (!ts.empty() && !number(ts, g.answer.t))
       throw InputError(located(path, lineno, "t '" + ts + "' is not a number"));
-    for (auto [c, name] : {std::pair{u, "u"}, {v, "v"}}) {
-      double ignored;
-      if (c >= 0 && !f[std::size_t(c)].empty() && !number(f[std::size_t(c)], ignored))
+    for (auto [c, name, out] : {std::tuple{u, "u", &g.answer.u}, {v, "v", &g.answer.v}})
+      if (c >= 0 && !f[std::size_t(c)].empty() && !number(f[std::size_t(c)], *out))
         throw InputError(located(path, lineno, std::string(name) + " '" + f[std::size_t(c)] + "' is not a number"));
-    }
     const auto [it, fresh] = out.emplace(key, g);
     if (!fresh)
       throw InputError(located(path, lineno, "duplicate id '" + key + "' (first at line " +
