@@ -4,6 +4,7 @@
 
 #include "run_rayaudit.h"
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -327,6 +328,45 @@ TEST(AuditGrade, BadAnswersExitTwoWithFileLineAndWriteNothing) {
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
   EXPECT_EQ(rayaudit("audit --grade " + answers.string()).code, 2) << "--grade needs --cases";
+}
+
+// ------------------------------------------------- --cases memory ---
+// Peak resident memory (kB) of one rayaudit run, its output discarded.
+long peak_rss_kb(const std::vector<std::string>& args) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv = {const_cast<char*>(RAYAUDIT_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    if (!std::freopen("/dev/null", "w", stdout)) ::_exit(127);
+    ::execv(RAYAUDIT_EXE, argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  struct rusage ru {};
+  ::wait4(pid, &status, 0, &ru);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  return ru.ru_maxrss;
+}
+
+// Issue 15: `audit --cases` held every row and its JSON (175x the CSV). Now
+// streamed: 100k rows peak where 20k do (the old code grew ~3 kB per row).
+TEST(AuditCli, CasesMemoryDoesNotGrowWithRows) {
+  auto make = [&](const fs::path& p, int rows) {
+    std::ofstream out(p);
+    out << kHeader;
+    for (int i = 0; i < rows; ++i)
+      out << 0.001 * (i % 997) << ",0.25,1,0,0,-1,0,0,0,1,0,0,0,1," << (i % 3) << "\n";
+  };
+  const fs::path small = tmp("rows20k.csv"), large = tmp("rows100k.csv"), json = tmp("rows.json");
+  make(small, 20000);
+  make(large, 100000);
+  const long a = peak_rss_kb({"audit", "--cases", small.string(), "--methods", "moller", "--json", json.string()});
+  const long b = peak_rss_kb({"audit", "--cases", large.string(), "--methods", "moller", "--json", json.string()});
+  std::printf("peak RSS: 20k rows %ld kB, 100k rows %ld kB\n", a, b);
+  EXPECT_LT(b, a + 25 * 1024) << "20k rows: " << a << " kB, 100k rows: " << b << " kB";
+  EXPECT_EQ(nlohmann::json::parse(slurp(json))["cases"].size(), 100000u);
+  fs::remove(small), fs::remove(large), fs::remove(json);
 }
 
 }  // namespace
