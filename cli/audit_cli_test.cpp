@@ -172,6 +172,10 @@ TEST(AuditCli, AbsurdCountsAndIgnoredOptionsAreUsageErrors) {
   EXPECT_NE(r.err.find("above the limit of 10000000000 (1e10) rays per family"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
   EXPECT_EQ(rayaudit("audit --rays 0").code, 2);
+  r = rayaudit("audit --export-cases " + tmp("huge.csv").string() + " --rays 20000000");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("above the export's limit of 10000000"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(tmp("huge.csv")));
   EXPECT_EQ(rayaudit("audit --threads -1 --rays 10").code, 2);
   EXPECT_EQ(rayaudit("audit --seed -1 --rays 10").code, 2);
   // Options that would be silently ignored.

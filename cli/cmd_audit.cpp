@@ -28,6 +28,7 @@ using namespace ra::audit;
 // bound is time: 1e10 rays per family is ~30 hours of the full registry on 2
 // cores, what a release sign-off spreads over a CI matrix with --shard.
 constexpr long long kMaxRays = 10000000000LL;
+constexpr long long kMaxExportRays = 10000000;
 
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
@@ -263,6 +264,10 @@ void export_cases(const Args& a) {
   if (!a.json.empty() || !a.csv.empty())
     throw ra::InputError("audit: --export-cases writes only the cases CSV; run the audit separately for --json/--csv");
   if (!a.methods.empty()) throw ra::InputError("audit: --export-cases exports cases, not methods' answers: drop --methods");
+  // The export holds its rows in memory before writing them (~350 bytes each).
+  if (a.rays > kMaxExportRays)
+    throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
+                         std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
   ra::check_output_path(a.export_cases);
   const auto precisions = chosen_precisions(a.precision);
   // Exported inputs are double unless only float was asked for.
