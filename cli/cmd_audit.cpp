@@ -1,9 +1,13 @@
 // `rayaudit audit`: grades the registry's methods against the exact oracle
-// (validation/audit.h) over generated families, user cases (--cases) or exports them (--export-cases).
+// (validation/audit.h) over generated families (whole or one --shard), user cases (--cases),
+// answers from any language (--grade), exports cases (--export-cases), merges shards (audit merge).
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -13,21 +17,40 @@
 #include "cases_csv.h"
 #include "command.h"
 #include "errors.h"
+#include "grade.h"
 #include "registry.h"
 
 namespace {
 
 using namespace ra::audit;
 
-// Above this an audit runs for hours and its task list alone takes gigabytes.
-constexpr long long kMaxRays = 100000000;
+// Memory does not grow with --rays (chunks are numbered, not listed), so the
+// bound is time: 1e10 rays per family is ~30 hours of the full registry on 2
+// cores, what a release sign-off spreads over a CI matrix with --shard.
+constexpr long long kMaxRays = 10000000000LL;
+constexpr long long kMaxExportRays = 10000000;
 
 struct Args {
-  std::string methods, precision = "float,double", families, json, csv, cases, export_cases;
+  std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
+  std::vector<std::string> merge_inputs;
 };
+
+// "K/N" with 1 <= K <= N <= kMaxShards, or an error message.
+std::string parse_shard(const std::string& text, Shard& out) {
+  const auto slash = text.find('/');
+  auto whole = [](const std::string& s, std::uint64_t& v) {
+    if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos) return false;
+    v = std::stoull(s);
+    return true;
+  };
+  if (slash == std::string::npos || !whole(text.substr(0, slash), out.k) || !whole(text.substr(slash + 1), out.n) ||
+      out.k < 1 || out.k > out.n || out.n > kMaxShards)
+    return "'" + text + "' is not K/N with 1 <= K <= N <= " + std::to_string(kMaxShards) + " (e.g. 2/8: the second of eight)";
+  return {};
+}
 
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;
@@ -82,15 +105,59 @@ std::vector<std::string> chosen_families(const std::string& list) {
   return names;
 }
 
-// A one-line progress bar on stderr, only when stderr is a terminal.
-std::function<void(std::size_t, std::size_t)> progress_bar() {
-  if (!isatty(STDERR_FILENO)) return {};
-  return [](std::size_t done, std::size_t total) {
-    const int width = 40, filled = int(double(width) * double(done) / double(total));
-    std::fprintf(stderr, "\r[%s%s] %3d%% %zu/%zu chunks", std::string(std::size_t(filled), '#').c_str(),
-                 std::string(std::size_t(width - filled), ' ').c_str(), int(100.0 * double(done) / double(total)),
-                 done, total);
-    if (done == total) std::fprintf(stderr, "\r%*s\r", width + 40, "");
+// 1234567 -> "1.23M": counts and rates at a glance.
+std::string si(double v) {
+  const char* unit[] = {"", "k", "M", "G", "T"};
+  int u = 0;
+  while (v >= 999.5 && u < 4) v /= 1000, ++u;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, u ? "%.3g%s" : "%.0f%s", v, unit[u]);
+  return buf;
+}
+std::string duration(double s) {
+  if (!std::isfinite(s)) return "?";
+  const long long t = (long long)std::llround(s);
+  char buf[48];
+  if (t >= 3600) std::snprintf(buf, sizeof buf, "%lldh%02lldm", t / 3600, t / 60 % 60);
+  else if (t >= 60) std::snprintf(buf, sizeof buf, "%lldm%02llds", t / 60, t % 60);
+  else std::snprintf(buf, sizeof buf, "%llds", t);
+  return buf;
+}
+
+// Progress on stderr with rays/s and ETA: a bar redrawn in place on a
+// terminal (4 times a second), else a plain line every 10 s, so CI logs show
+// a long audit is alive while runs shorter than that stay silent.
+std::function<void(std::uint64_t, std::uint64_t)> progress_reporter() {
+  using clock = std::chrono::steady_clock;
+  struct State {
+    bool tty;
+    clock::time_point start, last;
+    bool printed = false;
+  };
+  auto st = std::make_shared<State>(State{isatty(STDERR_FILENO) != 0, clock::now(), clock::now()});
+  return [st](std::uint64_t done, std::uint64_t total) {
+    const auto now = clock::now();
+    const bool finished = done >= total;
+    const double period = st->tty ? 0.25 : 10.0;
+    if (!finished && std::chrono::duration<double>(now - st->last).count() < period) return;
+    if (finished && !st->printed) return;
+    st->last = now;
+    st->printed = true;
+    const double elapsed = std::chrono::duration<double>(now - st->start).count();
+    const double rate = elapsed > 0 ? double(done) / elapsed : 0;
+    const double frac = total ? double(done) / double(total) : 1;
+    const std::string eta = finished ? "done in " + duration(elapsed)
+                                     : "ETA " + duration(rate > 0 ? double(total - done) / rate : INFINITY);
+    if (st->tty) {
+      const int width = 30, filled = int(double(width) * frac);
+      std::fprintf(stderr, "\r[%s%s] %5.1f%% %s/%s rays  %s rays/s  %s   ", std::string(std::size_t(filled), '#').c_str(),
+                   std::string(std::size_t(width - filled), ' ').c_str(), 100 * frac, si(double(done)).c_str(),
+                   si(double(total)).c_str(), si(rate).c_str(), eta.c_str());
+      if (finished) std::fprintf(stderr, "\n");
+    } else {
+      std::fprintf(stderr, "audit: %5.1f%% %llu/%llu rays, %s rays/s, %s\n", 100 * frac, (unsigned long long)done,
+                   (unsigned long long)total, si(rate).c_str(), eta.c_str());
+    }
     std::fflush(stderr);
   };
 }
@@ -98,52 +165,97 @@ std::function<void(std::size_t, std::size_t)> progress_bar() {
 // ---------------------------------------------------------- --cases ---
 nlohmann::json t_json(double t) { return std::isfinite(t) ? nlohmann::json(t) : nlohmann::json(nullptr); }
 
+// Streams the cases (issue 15: memory independent of the number of rows):
+// a first pass validates the whole file, so bad input prints and writes
+// nothing; the second grades row by row, printing the table and writing the
+// JSON (byte for byte what nlohmann's dump(2) of the whole document gives).
 void audit_cases(const Args& a) {
   if (!a.csv.empty())
     throw ra::InputError("audit: --csv writes per-family rows, which --cases has none of; use --json");
   ra::OutputBatch outputs({a.json});
-  const auto cases = read_cases_csv(a.cases);  // throws before anything is written
+  for_each_case(a.cases, [](const UserCase&, long) {});  // throws before anything is written
   std::vector<const ra::Method*> tri_methods;
   for (const ra::Method* m : chosen_methods(a.methods))
     if (m->kind == ra::Kind::triangle) tri_methods.push_back(m);
-  nlohmann::json out = nlohmann::json::array();
-  std::printf("%-16s %-10s %-24s", "ID", "VERDICT", "T (exact)");
-  for (const auto* m : tri_methods) std::printf(" %-11.11s", m->name.c_str());
-  std::printf("\n%-16s %-10s %-24s", "", "", "");
-  for (std::size_t i = 0; i < tri_methods.size(); ++i) std::printf(" %-11s", "float dbl");
-  std::printf("\n");
-  int wrong = 0;
-  for (const UserCase& c : cases) {
-    const auto ans = ra::oracle::triangle(c.ray, c.tri.a, c.tri.b, c.tri.c);
-    nlohmann::json answers = nlohmann::json::object();
-    std::printf("%-16.16s %-10s %-24.17g", c.id.c_str(), std::string(ra::oracle::verdict_name(ans.verdict)).c_str(), ans.t);
-    for (const auto* m : tri_methods) {
-      std::string cell;
-      for (Precision p : {Precision::f32, Precision::f64}) {
-        std::optional<double> t;
-        if (p == Precision::f32) {
-          if (auto h = m->tri_f.hit(ra::Rayf(c.ray), ra::Vec3f(c.tri.a), ra::Vec3f(c.tri.b), ra::Vec3f(c.tri.c), false))
-            t = double(h->t);
-        } else if (auto h = m->tri_d.hit(c.ray, c.tri.a, c.tri.b, c.tri.c, false)) {
-          t = h->t;
-        }
-        answers[m->name + "/" + precision_name(p)] = {{"hit", t.has_value()}, {"t", t ? t_json(*t) : nullptr}};
-        // '!' marks an answer the exact verdict contradicts (boundary etc. never do).
-        const bool bad = (ans.verdict == ra::oracle::Verdict::hit && !t) ||
-                         (ans.verdict == ra::oracle::Verdict::miss && t);
-        wrong += bad;
-        cell += std::string(t ? "hit" : "miss") + (bad ? "!" : "") + " ";
-      }
-      std::printf(" %-11s", cell.c_str());
-    }
+  auto grade_all = [&](std::ostream* json) {
+    std::printf("%-16s %-10s %-24s", "ID", "VERDICT", "T (exact)");
+    for (const auto* m : tri_methods) std::printf(" %-11.11s", m->name.c_str());
+    std::printf("\n%-16s %-10s %-24s", "", "", "");
+    for (std::size_t i = 0; i < tri_methods.size(); ++i) std::printf(" %-11s", "float dbl");
     std::printf("\n");
-    out.push_back({{"id", c.id_is_row ? nlohmann::json(std::stol(c.id)) : nlohmann::json(c.id)},
-                   {"verdict", std::string(ra::oracle::verdict_name(ans.verdict))},
-                   {"t", t_json(ans.t)},
-                   {"answers", answers}});
+    long wrong = 0, n = 0;
+    for_each_case(a.cases, [&](const UserCase& c, long) {
+      const auto ans = ra::oracle::triangle(c.ray, c.tri.a, c.tri.b, c.tri.c);
+      nlohmann::json answers = nlohmann::json::object();
+      std::printf("%-16.16s %-10s %-24.17g", c.id.c_str(), std::string(ra::oracle::verdict_name(ans.verdict)).c_str(), ans.t);
+      for (const auto* m : tri_methods) {
+        std::string cell;
+        for (Precision p : {Precision::f32, Precision::f64}) {
+          std::optional<double> t;
+          if (p == Precision::f32) {
+            if (auto h = m->tri_f.hit(ra::Rayf(c.ray), ra::Vec3f(c.tri.a), ra::Vec3f(c.tri.b), ra::Vec3f(c.tri.c), false))
+              t = double(h->t);
+          } else if (auto h = m->tri_d.hit(c.ray, c.tri.a, c.tri.b, c.tri.c, false)) {
+            t = h->t;
+          }
+          answers[m->name + "/" + precision_name(p)] = {{"hit", t.has_value()}, {"t", t ? t_json(*t) : nullptr}};
+          // '!' marks an answer the exact verdict contradicts (boundary etc. never do).
+          const bool bad = (ans.verdict == ra::oracle::Verdict::hit && !t) ||
+                           (ans.verdict == ra::oracle::Verdict::miss && t);
+          wrong += bad;
+          cell += std::string(t ? "hit" : "miss") + (bad ? "!" : "") + " ";
+        }
+        std::printf(" %-11s", cell.c_str());
+      }
+      std::printf("\n");
+      if (json) {
+        const nlohmann::json row = {{"id", c.id_is_row ? nlohmann::json(std::stol(c.id)) : nlohmann::json(c.id)},
+                                    {"verdict", std::string(ra::oracle::verdict_name(ans.verdict))},
+                                    {"t", t_json(ans.t)},
+                                    {"answers", answers}};
+        // An element of "cases" sits 4 spaces deep in the whole document.
+        std::string text = row.dump(2), indented = "    ";
+        for (char ch : text) {
+          indented += ch;
+          if (ch == '\n') indented += "    ";
+        }
+        *json << (n ? ",\n" : "\n") << indented;
+      }
+      ++n;
+    });
+    std::printf("%ld case(s); %ld answer(s) contradict the exact verdict (marked !)\n", n, wrong);
+    return n;
+  };
+  if (a.json.empty()) {
+    grade_all(nullptr);
+  } else {
+    ra::write_atomically(a.json, [&](const std::filesystem::path& tmp) {
+      std::ofstream out(tmp, std::ios::binary);
+      out << "{\n  \"cases\": [";
+      out << (grade_all(&out) ? "\n  ]\n}\n" : "]\n}\n");
+      out.close();
+      if (!out) throw ra::InputError(ra::located(a.json, 0, "cannot write"));
+    });
   }
-  std::printf("%zu case(s); %d answer(s) contradict the exact verdict (marked !)\n", cases.size(), wrong);
-  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"cases", out}}.dump(2) + "\n");
+  outputs.commit();
+}
+
+// ----------------------------------------------------------- --grade ---
+void grade(const Args& a) {
+  if (!a.methods.empty()) throw ra::InputError("audit: --grade grades the answers file, not --methods: drop --methods");
+  ra::OutputBatch outputs({a.json, a.csv});
+  const auto ps = chosen_precisions(a.precision);
+  // Answers are double unless only float was asked for (as --export-cases).
+  const Precision p = ps.size() == 1 ? ps[0] : Precision::f64;
+  const std::string method = std::filesystem::path(a.grade).stem().string();
+  const Report rep = grade_answers(a.grade, a.cases, p, method.empty() ? "answers" : method);
+  std::fputs(rep.summary_table().c_str(), stdout);
+  if (!a.json.empty()) {
+    nlohmann::json j = rep.to_json();
+    j["graded"] = {{"answers", a.grade}, {"cases", a.cases}};
+    ra::write_text_atomically(a.json, j.dump(1) + "\n");
+  }
+  if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
 
@@ -152,6 +264,10 @@ void export_cases(const Args& a) {
   if (!a.json.empty() || !a.csv.empty())
     throw ra::InputError("audit: --export-cases writes only the cases CSV; run the audit separately for --json/--csv");
   if (!a.methods.empty()) throw ra::InputError("audit: --export-cases exports cases, not methods' answers: drop --methods");
+  // The export holds its rows in memory before writing them (~350 bytes each).
+  if (a.rays > kMaxExportRays)
+    throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
+                         std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
   ra::check_output_path(a.export_cases);
   const auto precisions = chosen_precisions(a.precision);
   // Exported inputs are double unless only float was asked for.
@@ -173,7 +289,12 @@ void audit(const Args& a) {
   opt.rays = a.rays;
   opt.seed = a.seed;
   opt.threads = a.threads;
-  opt.progress = progress_bar();
+  opt.progress = progress_reporter();
+  if (!a.shard.empty()) {
+    Shard sh;
+    if (const std::string bad = parse_shard(a.shard, sh); !bad.empty()) throw ra::InputError("--shard: " + bad);
+    opt.shard = sh;
+  }
   std::vector<TriangleSubject> tris;
   std::vector<SphereSubject> spheres;
   for (const ra::Method* m : ms)
@@ -194,7 +315,85 @@ void audit(const Args& a) {
   }
   const Report rep = run(tris, spheres, opt);
   std::fputs(rep.summary_table().c_str(), stdout);
+  if (opt.shard)
+    std::printf("shard %s: partial counts; combine every shard's --json with `rayaudit audit merge`\n", a.shard.c_str());
   if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
+  if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
+  outputs.commit();
+}
+
+// ------------------------------------------------------------ merge ---
+struct ShardFile {
+  std::string path;
+  nlohmann::json json;
+  Report report;
+};
+
+ShardFile read_shard(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ra::InputError(ra::located(path, 0, "cannot open the shard's JSON"));
+  ShardFile f{path, nlohmann::json::parse(in, nullptr, false), {}};
+  if (f.json.is_discarded()) throw ra::InputError(ra::located(path, 0, "not JSON (an `audit --shard K/N --json` output?)"));
+  if (!f.json.is_object() || !f.json.contains("shard"))
+    throw ra::InputError(ra::located(path, 0, "not a shard's output (no \"shard\" key: run audit with --shard K/N)"));
+  try {
+    f.report = Report::from_json(f.json);
+  } catch (const std::exception& e) {
+    throw ra::InputError(ra::located(path, 0, e.what()));
+  }
+  return f;
+}
+
+// What must agree between shards of one run, as "name: value" texts.
+std::vector<std::pair<std::string, std::string>> run_identity(const ShardFile& f) {
+  std::string cells;
+  for (const auto& c : f.json["cells"]) cells += c.value("subject", "") + "|" + c.value("family", "") + "|" + c.value("sweep", "") + ";";
+  std::string methods;
+  for (const auto& s : f.report.subjects) methods += (methods.empty() ? "" : ",") + s;
+  return {{"version", f.json.value("version", "(none)")},
+          {"seed", std::to_string(f.report.seed)},
+          {"rays per family", std::to_string(f.report.rays)},
+          {"methods", methods},
+          {"families", cells},
+          {"shard count", std::to_string(f.report.shard->n)}};
+}
+
+void merge(const Args& a) {
+  if (a.json.empty()) throw ra::InputError("audit merge: --json OUT is required");
+  ra::OutputBatch outputs({a.json, a.csv});
+  std::vector<ShardFile> files;
+  for (const auto& p : a.merge_inputs) files.push_back(read_shard(p));
+  const auto first = run_identity(files[0]);
+  std::vector<const ShardFile*> by_k(std::size_t(files[0].report.shard->n) + 1, nullptr);
+  for (const ShardFile& f : files) {
+    const auto id = run_identity(f);
+    for (std::size_t i = 0; i < id.size(); ++i)
+      if (id[i].second != first[i].second) {
+        std::string mine = id[i].second, theirs = first[i].second;
+        if (mine.size() > 60 || theirs.size() > 60) mine = theirs = "";  // the lists: just say they differ
+        throw ra::InputError("audit merge: " + f.path + " and " + files[0].path + " are shards of different runs: " +
+                             id[i].first + (mine.empty() ? " differ" : " " + mine + " vs " + theirs));
+      }
+    const auto k = std::size_t(f.report.shard->k);
+    if (k < 1 || k >= by_k.size()) throw ra::InputError(ra::located(f.path, 0, "shard k out of range 1..n"));
+    if (by_k[k])
+      throw ra::InputError("audit merge: " + f.path + " and " + by_k[k]->path + " are both shard " + std::to_string(k) +
+                           "/" + std::to_string(by_k.size() - 1));
+    by_k[k] = &f;
+  }
+  if (files[0].json.value("version", "") != RAYAUDIT_VERSION)
+    throw ra::InputError(ra::located(files[0].path, 0, "written by rayaudit " + files[0].json.value("version", "(unknown)") +
+                                                         "; merge with that version (this is " + RAYAUDIT_VERSION + ")"));
+  for (std::size_t k = 1; k < by_k.size(); ++k)
+    if (!by_k[k])
+      throw ra::InputError("audit merge: shard " + std::to_string(k) + "/" + std::to_string(by_k.size() - 1) +
+                           " is missing (" + std::to_string(files.size()) + " file(s) given, the first " + files[0].path + ")");
+  Report rep = files[0].report;
+  rep.shard.reset();
+  for (std::size_t i = 1; i < files.size(); ++i)
+    for (std::size_t c = 0; c < rep.cells.size(); ++c) rep.cells[c].stats.merge(files[i].report.cells[c].stats);
+  std::fputs(rep.summary_table().c_str(), stdout);
+  ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
@@ -209,7 +408,18 @@ void setup(CLI::App& app) {
   cmd->add_option("--rays", a->rays,
                   "Ray/primitive tests per family per method and precision (a ray against a fan of 6 counts 6)")
       ->capture_default_str()
-      ->check(CLI::Range(1LL, kMaxRays).description("1 to 100000000 (about 20 minutes on 2 cores)"));
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            if (v.empty() || v.size() > 18 || v.find_first_not_of("0123456789") != std::string::npos)
+              return "'" + v + "' is not a whole number of rays";
+            const long long n = std::stoll(v);
+            if (n < 1) return "at least 1 ray";
+            if (n > kMaxRays)
+              return v + " is above the limit of 10000000000 (1e10) rays per family, about 30 hours of every "
+                         "method on 2 cores; spread a run that size over machines with --shard K/N";
+            return {};
+          },
+          "1 to 1e10"));
   cmd->add_option("--seed", a->seed, "Seed of every generated case")
       ->capture_default_str()
       ->check(CLI::Validator(
@@ -222,10 +432,28 @@ void setup(CLI::App& app) {
   cmd->add_option("--csv", a->csv, "Write one row per method x precision x family x sweep value");
   auto* cases = cmd->add_option("--cases", a->cases,
                                 "Audit the cases of this CSV (columns ox..cz, optional id) instead of generating");
-  cmd->add_option("--export-cases", a->export_cases,
-                  "Write the generated cases with exact verdicts as a CSV of C99 hex floats")
-      ->excludes(cases);
-  cmd->callback([a] {
+  auto* exp = cmd->add_option("--export-cases", a->export_cases,
+                              "Write the generated cases with exact verdicts as a CSV of C99 hex floats")
+                   ->excludes(cases);
+  cmd->add_option("--grade", a->grade,
+                  "Grade answers from your own intersector (CSV id,hit,t[,u,v], one row per case of --cases)")
+      ->needs(cases);
+  auto* shard = cmd->add_option("--shard", a->shard,
+                                "Judge shard K of N (e.g. 2/8): the same 1/N of every family's rays for any "
+                                "thread count; combine the --json of all N with `audit merge`")
+                    ->excludes(cases)
+                    ->excludes(exp);
+  (void)shard;
+  auto* merge_cmd = cmd->add_subcommand(
+      "merge", "Combine the --json outputs of every shard of one audit into what the unsharded run writes");
+  merge_cmd->add_option("shards", a->merge_inputs, "The shards' JSON files (audit --shard K/N --json)")
+      ->required();
+  merge_cmd->add_option("--json", a->json, "Write the merged JSON here")->required();
+  merge_cmd->add_option("--csv", a->csv, "Write the merged per-cell CSV here");
+  merge_cmd->callback([a] { merge(*a); });
+  cmd->callback([a, merge_cmd] {
+    if (merge_cmd->parsed()) return;
+    if (!a->grade.empty()) return grade(*a);
     if (!a->cases.empty()) return audit_cases(*a);
     if (!a->export_cases.empty()) return export_cases(*a);
     audit(*a);

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <mutex>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "spawn.h"
@@ -137,6 +138,54 @@ nlohmann::json Stats::to_json() const {
   return j;
 }
 
+nlohmann::json Stats::histograms_json() const {
+  auto sparse = [](const auto& h) {
+    nlohmann::json out = nlohmann::json::array();
+    for (std::size_t i = 0; i < h.size(); ++i)
+      if (h[i]) out.push_back({i, h[i]});
+    return out;
+  };
+  return {{"t_ulps", sparse(ulp_hist)}, {"t_rel", sparse(rel_hist)}};
+}
+
+Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
+  auto u = [&](const char* key) -> std::uint64_t {
+    if (!j.is_object() || !j.contains(key) || !j[key].is_number_unsigned())
+      throw std::runtime_error(std::string("stats: '") + key + "' is missing or not a count");
+    return j[key].get<std::uint64_t>();
+  };
+  Stats s;
+  s.tests = u("tests"), s.true_hits = u("true_hits"), s.false_hits = u("false_hits");
+  s.true_misses = u("true_misses"), s.false_misses = u("false_misses");
+  s.boundary_hits = u("boundary_hits"), s.boundary_misses = u("boundary_misses");
+  s.coplanar_hits = u("coplanar_hits"), s.coplanar_misses = u("coplanar_misses");
+  s.degenerate_hits = u("degenerate_hits"), s.degenerate_misses = u("degenerate_misses");
+  s.nan_inf = u("nan_inf"), s.wrong_t = u("wrong_t");
+  s.groups = u("groups"), s.leaks = u("leaks"), s.double_hits = u("double_hits");
+  s.spawned = u("spawned"), s.self_hits = u("self_hits");
+  s.t_samples = u("t_samples"), s.max_ulps = u("t_ulps_max");
+  if (!j.contains("t_rel_max") || !j["t_rel_max"].is_number())
+    throw std::runtime_error("stats: 't_rel_max' is missing or not a number");
+  s.max_rel = j["t_rel_max"].get<double>();
+  auto read = [&](const char* key, auto& hist) {
+    std::uint64_t sum = 0;
+    if (!h.is_object() || !h.contains(key) || !h[key].is_array())
+      throw std::runtime_error(std::string("histograms: '") + key + "' is missing (not a shard's output?)");
+    for (const auto& e : h[key]) {
+      if (!e.is_array() || e.size() != 2 || !e[0].is_number_unsigned() || !e[1].is_number_unsigned() ||
+          e[0].get<std::uint64_t>() >= hist.size())
+        throw std::runtime_error(std::string("histograms: '") + key + "' holds a bad [bin, count] pair");
+      hist[e[0].get<std::size_t>()] += e[1].get<std::uint64_t>();
+      sum += e[1].get<std::uint64_t>();
+    }
+    if (sum != s.t_samples)
+      throw std::runtime_error(std::string("histograms: '") + key + "' does not add up to t_samples");
+  };
+  read("t_ulps", s.ulp_hist);
+  read("t_rel", s.rel_hist);
+  return s;
+}
+
 // -------------------------------------------------------- evaluation ---
 namespace {
 
@@ -194,6 +243,20 @@ int crossings(const oracle::Answer* a, int n) {
   return int(std::unique(ts.begin(), ts.end()) - ts.begin());
 }
 
+// Books a group's verdicts once its members are booked: `hits` of `count`.
+void book_group(Stats& st, int count, int hits, int cross, bool proper) {
+  if (count <= 1) return;
+  if (cross > 0 && hits > cross) ++st.double_hits;
+  // Leaks are judged on proper groups only (see group_is_proper), and
+  // only for crossings ahead of the origin: an origin on the surface
+  // (t = 0) is the secondary family's subject, and pbrt-style methods
+  // reject t <= their error bound on purpose.
+  if (proper) {
+    ++st.groups;
+    if (cross > 0 && hits == 0) ++st.leaks;
+  }
+}
+
 template <class T>
 void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
                  const std::vector<oracle::Answer>& ans, const std::vector<int>& cross,
@@ -210,17 +273,7 @@ void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
       hits += h.has_value();
       book<T>(st, ans[pair], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
     }
-    if (p.count > 1) {
-      if (cross[pi] > 0 && hits > cross[pi]) ++st.double_hits;
-      // Leaks are judged on proper groups only (see group_is_proper), and
-      // only for crossings ahead of the origin: an origin on the surface
-      // (t = 0) is the secondary family's subject, and pbrt-style methods
-      // reject t <= their error bound on purpose.
-      if (proper[pi]) {
-        ++st.groups;
-        if (cross[pi] > 0 && hits == 0) ++st.leaks;
-      }
-    }
+    book_group(st, p.count, hits, cross[pi], proper[pi]);
   }
 }
 
@@ -264,28 +317,91 @@ void eval_spheres(const SphereSubject& s, const std::vector<SphereCase>& cs,
   }
 }
 
-constexpr int kChunk = 256;  // probes per task: fixed, so cases never depend on threads
+constexpr int kChunk = 256;  // probes per chunk: fixed, so cases never depend on threads or shards
 
-struct Task {
+// The work of a run without a task list (which grew with --rays): per
+// (family, sweep value) its chunk count, and the first global task number of
+// it, so a task number maps to (family, sweep, chunk) by a binary search in
+// a table of one row per sweep value.
+struct SweepPlan {
   const Family* family;
+  std::size_t fam_index;
   int sweep;
-  int chunk;
-  int count;
+  long long probes;           // of the unsharded run
+  std::uint64_t first_task;   // tasks of earlier sweep values (this shard's)
+  std::uint64_t tasks;        // this shard's chunks of this sweep value
+  std::uint64_t per_probe;    // tests per probe, as --rays counts them
+  // Sharded, a sweep value of fewer than 4 n chunks is split by probe (every
+  // shard generates each chunk and keeps probes j with j % n == k - 1), so
+  // small runs split evenly too; larger ones are dealt whole chunks, so no
+  // shard generates what it does not judge.
+  bool by_probe;
 };
 
-int probes_per_sweep(const Family& f, int sweep, long long rays) {
-  const long long per = rays / (long long)f.sweep.size() / (f.secondary ? 2 : f.tris_per_probe(sweep));
-  return int(std::max(1LL, per));
+struct Chunk {
+  const SweepPlan* sweep;
+  std::uint64_t index;  // chunk number within the sweep value
+  int count;            // probes in it
+};
+
+// This shard's probes of a sweep value dealt by probe: j < probes, j % n == k - 1.
+std::uint64_t dealt(std::uint64_t probes, Shard s) {
+  return probes > s.k - 1 ? (probes - (s.k - 1) + s.n - 1) / s.n : 0;
 }
 
-std::vector<Task> plan(const std::vector<const Family*>& fams, long long rays) {
-  std::vector<Task> tasks;
-  for (const Family* f : fams)
-    for (int s = 0; s < int(f->sweep.size()); ++s) {
-      const int n = probes_per_sweep(*f, s, rays);
-      for (int c = 0; c * kChunk < n; ++c) tasks.push_back({f, s, c, std::min(kChunk, n - c * kChunk)});
+struct Plan {
+  std::vector<SweepPlan> sweeps;
+  std::uint64_t tasks = 0, tests = 0;
+  Shard shard;
+
+  Chunk chunk(std::uint64_t task) const {
+    auto it = std::upper_bound(sweeps.begin(), sweeps.end(), task,
+                               [](std::uint64_t t, const SweepPlan& s) { return t < s.first_task; });
+    const SweepPlan& sp = *(it - 1);
+    const std::uint64_t c = sp.by_probe ? task - sp.first_task : (task - sp.first_task) * shard.n + (shard.k - 1);
+    return {&sp, c, int(std::min<long long>(kChunk, sp.probes - (long long)c * kChunk))};
+  }
+};
+
+// The probes of chunk c (global index c * kChunk + i) dealt to this shard.
+template <class V> V keep_dealt(const V& all, std::uint64_t c, Shard s) {
+  V out;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if ((c * kChunk + i) % s.n == s.k - 1) out.push_back(all[i]);
+  return out;
+}
+std::uint64_t dealt_in_chunk(const Chunk& ch, Shard s) {
+  const std::uint64_t first = ch.index * kChunk;
+  return dealt(first + std::uint64_t(ch.count), s) - dealt(first, s);
+}
+
+Plan plan(const std::vector<const Family*>& fams, long long rays, Shard shard) {
+  Plan pl;
+  pl.shard = shard;
+  for (std::size_t fi = 0; fi < fams.size(); ++fi) {
+    const Family& f = *fams[fi];
+    for (int s = 0; s < int(f.sweep.size()); ++s) {
+      SweepPlan sp{&f, fi, s, probes_per_sweep(f, s, rays), pl.tasks, 0,
+                   std::uint64_t(f.secondary ? 2 : f.tris_per_probe(s)), false};
+      const auto chunks = std::uint64_t((sp.probes + kChunk - 1) / kChunk);
+      sp.by_probe = shard.n > 1 && chunks < 4 * shard.n;
+      std::uint64_t probes;
+      if (sp.by_probe) {
+        probes = dealt(std::uint64_t(sp.probes), shard);
+        sp.tasks = probes ? chunks : 0;
+      } else {
+        sp.tasks = dealt(chunks, shard);
+        // This shard's probes: whole chunks, less what the last chunk lacks if it is ours.
+        probes = sp.tasks * kChunk;
+        if (sp.tasks && (chunks - 1) % shard.n == shard.k - 1) probes -= chunks * kChunk - std::uint64_t(sp.probes);
+      }
+      if (sp.tasks == 0) continue;
+      pl.tests += probes * sp.per_probe;
+      pl.tasks += sp.tasks;
+      pl.sweeps.push_back(sp);
     }
-  return tasks;
+  }
+  return pl;
 }
 
 // Exact answers per (probe, triangle) pair, probe after probe: probes may
@@ -302,13 +418,37 @@ std::vector<oracle::Answer> judge(const TriangleBatch& b) {
 
 }  // namespace
 
+void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given,
+                 int count, bool closed) {
+  std::vector<oracle::Answer> ans;
+  ans.reserve(std::size_t(count));
+  for (int k = 0; k < count; ++k) ans.push_back(oracle::triangle(ray, tris[k].a, tris[k].b, tris[k].c));
+  int hits = 0;
+  for (int k = 0; k < count; ++k) {
+    const GivenAnswer& g = given[k];
+    hits += g.hit;
+    if (p == Precision::f32)
+      book<float>(st, ans[std::size_t(k)], g.hit, finite_hit(TriangleHit<float>{float(g.t), float(g.u), float(g.v)}),
+                  float(g.t));
+    else
+      book<double>(st, ans[std::size_t(k)], g.hit, finite_hit(TriangleHit<double>{g.t, g.u, g.v}), g.t);
+  }
+  const bool proper = closed || (count > 1 && group_is_proper(tris, count, ray.d));
+  book_group(st, count, hits, count > 1 ? crossings(ans.data(), count) : 0, proper);
+}
+
+long long probes_per_sweep(const Family& f, int sweep, long long rays) {
+  const long long per = rays / (long long)f.sweep.size() / (f.secondary ? 2 : f.tris_per_probe(sweep));
+  return std::max(1LL, per);
+}
+
 std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
                                    long long rays) {
   std::vector<ProbeCase> out;
-  const int n = probes_per_sweep(f, sweep, rays);
-  for (int c = 0; c * kChunk < n; ++c) {
+  const long long n = probes_per_sweep(f, sweep, rays);
+  for (long long c = 0; c * kChunk < n; ++c) {
     TriangleBatch b;
-    generate(f, sweep, p, stream_seed(seed, f.name, sweep, c), std::min(kChunk, n - c * kChunk), b);
+    generate(f, sweep, p, stream_seed(seed, f.name, sweep, std::uint64_t(c)), int(std::min<long long>(kChunk, n - c * kChunk)), b);
     for (const Probe& pr : b.probes) {
       ProbeCase pc{pr.ray, {}, {}};
       for (int k = pr.first; k < pr.first + pr.count; ++k) {
@@ -325,9 +465,10 @@ std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std:
 std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
                                      long long rays) {
   std::vector<SphereCase> out;
-  const int n = probes_per_sweep(f, sweep, rays);
-  for (int c = 0; c * kChunk < n; ++c)
-    generate(f, sweep, p, stream_seed(seed, f.name, sweep, c), std::min(kChunk, n - c * kChunk), out);
+  const long long n = probes_per_sweep(f, sweep, rays);
+  for (long long c = 0; c * kChunk < n; ++c)
+    generate(f, sweep, p, stream_seed(seed, f.name, sweep, std::uint64_t(c)),
+             int(std::min<long long>(kChunk, n - c * kChunk)), out);
   return out;
 }
 
@@ -368,19 +509,26 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
         rep.cells[cell_index(s, fi, w)] = {s, fams[fi]->name, w, fams[fi]->sweep[std::size_t(w)], {}};
     }
 
-  const std::vector<Task> tasks = plan(fams, opt.rays);
-  std::atomic<std::size_t> next{0}, done{0};
+  const Shard shard = opt.shard.value_or(Shard{});
+  if (shard.n < 1 || shard.k < 1 || shard.k > shard.n)
+    throw std::invalid_argument("audit: shard " + std::to_string(shard.k) + "/" + std::to_string(shard.n) +
+                                " is not k/n with 1 <= k <= n");
+  rep.shard = opt.shard;
+  const Plan pl = plan(fams, opt.rays, shard);
+  std::atomic<std::uint64_t> next{0};
+  std::uint64_t done = 0;  // tests, under mu
   std::mutex mu;
-  auto family_index = [&](const Family* f) {
-    return std::size_t(std::find(fams.begin(), fams.end(), f) - fams.begin());
-  };
   auto worker = [&] {
     for (;;) {
-      const std::size_t ti = next++;
-      if (ti >= tasks.size()) return;
-      const Task& t = tasks[ti];
-      const std::size_t fi = family_index(t.family);
-      const std::uint64_t stream = stream_seed(opt.seed, t.family->name, t.sweep, t.chunk);
+      const std::uint64_t ti = next++;
+      if (ti >= pl.tasks) return;
+      const Chunk ch = pl.chunk(ti);
+      struct {
+        const Family* family;
+        int sweep, count;
+      } const t{ch.sweep->family, ch.sweep->sweep, ch.count};
+      const std::size_t fi = ch.sweep->fam_index;
+      const std::uint64_t stream = stream_seed(opt.seed, t.family->name, t.sweep, ch.index);
       std::vector<std::pair<std::size_t, Stats>> results;
       for (Precision p : {Precision::f32, Precision::f64}) {
         if (t.family->kind == Kind::triangle) {
@@ -389,6 +537,7 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           if (!any) continue;
           TriangleBatch b;
           generate(*t.family, t.sweep, p, stream, t.count, b);
+          if (ch.sweep->by_probe) b.probes = keep_dealt(b.probes, ch.index, shard);
           std::vector<oracle::Answer> ans;
           std::vector<int> cross;
           std::vector<char> proper;
@@ -420,6 +569,7 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           if (!any) continue;
           std::vector<SphereCase> cs;
           generate(*t.family, t.sweep, p, stream, t.count, cs);
+          if (ch.sweep->by_probe) cs = keep_dealt(cs, ch.index, shard);
           std::vector<oracle::Answer> ans;
           for (const auto& c : cs) ans.push_back(oracle::sphere(c.ray, c.center, c.radius));
           for (std::size_t si = 0; si < spheres.size(); ++si) {
@@ -433,8 +583,9 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
       }
       std::lock_guard<std::mutex> lock(mu);
       for (auto& [ci, st] : results) rep.cells[ci].stats.merge(st);
-      ++done;
-      if (opt.progress) opt.progress(done, tasks.size());
+      const std::uint64_t judged = ch.sweep->by_probe ? dealt_in_chunk(ch, shard) : std::uint64_t(t.count);
+      done += judged * ch.sweep->per_probe;
+      if (opt.progress) opt.progress(done, pl.tests);
     }
   };
   const int n = opt.threads > 0 ? opt.threads : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -482,8 +633,10 @@ nlohmann::json Report::to_json() const {
                   {"param", f ? f->param : ""},
                   {"sweep", c.sweep_label},
                   {"stats", c.stats.to_json()}});
+    if (shard) cs.back()["histograms"] = c.stats.histograms_json();
   }
-  return {{"seed", seed},
+  nlohmann::json out = {{"seed", seed},
+          {"version", RAYAUDIT_VERSION},
           {"rays_per_family", rays},
           {"semantics",
            "ray = {o + t d : max(tmin,0) <= t <= tmax}; closed triangle; inputs exact as given "
@@ -492,6 +645,52 @@ nlohmann::json Report::to_json() const {
            "counted apart, never wrong"},
           {"subjects", subs},
           {"cells", cs}};
+  if (shard) out["shard"] = {{"k", shard->k}, {"n", shard->n}};
+  return out;
+}
+
+Report Report::from_json(const nlohmann::json& j) {
+  auto need = [&](const nlohmann::json& o, const char* key) -> const nlohmann::json& {
+    if (!o.is_object() || !o.contains(key)) throw std::runtime_error(std::string("no '") + key + "' key");
+    return o[key];
+  };
+  Report r;
+  const auto& seed = need(j, "seed");
+  const auto& rays = need(j, "rays_per_family");
+  if (!seed.is_number_unsigned() || !rays.is_number_integer())
+    throw std::runtime_error("'seed' and 'rays_per_family' must be integers");
+  r.seed = seed.get<std::uint64_t>();
+  r.rays = rays.get<long long>();
+  if (j.contains("shard")) {
+    const auto& sh = j["shard"];
+    if (!need(sh, "k").is_number_unsigned() || !need(sh, "n").is_number_unsigned())
+      throw std::runtime_error("'shard' must hold counts k and n");
+    r.shard = Shard{sh["k"].get<std::uint64_t>(), sh["n"].get<std::uint64_t>()};
+  }
+  for (const auto& s : need(j, "subjects")) {
+    if (!need(s, "name").is_string() || !need(s, "kind").is_string())
+      throw std::runtime_error("a subject without a name or kind");
+    r.subjects.push_back(s["name"].get<std::string>());
+    r.kinds.push_back(s["kind"].get<std::string>());
+  }
+  for (const auto& c : need(j, "cells")) {
+    if (!need(c, "subject").is_string() || !need(c, "family").is_string() || !need(c, "sweep").is_string())
+      throw std::runtime_error("a cell without subject, family or sweep");
+    const auto it = std::find(r.subjects.begin(), r.subjects.end(), c["subject"].get<std::string>());
+    if (it == r.subjects.end()) throw std::runtime_error("a cell of an unknown subject");
+    Cell cell;
+    cell.subject = std::size_t(it - r.subjects.begin());
+    cell.family = c["family"].get<std::string>();
+    cell.sweep_label = c["sweep"].get<std::string>();
+    cell.sweep = 0;
+    if (const Family* f = find_family(cell.family)) {
+      const auto w = std::find(f->sweep.begin(), f->sweep.end(), cell.sweep_label);
+      cell.sweep = int(w - f->sweep.begin());
+    }
+    cell.stats = Stats::from_json(need(c, "stats"), c.contains("histograms") ? c["histograms"] : nlohmann::json());
+    r.cells.push_back(std::move(cell));
+  }
+  return r;
 }
 
 namespace {

@@ -108,14 +108,32 @@ struct Stats {
   // (wrong + leaks + double hits + NaN) per test: what "worst" ranks by.
   double badness() const;
   nlohmann::json to_json() const;
+  // The t error histograms as sparse [bin, count] pairs (shard outputs carry
+  // them, so merged medians are those of the unsharded run, bin for bin).
+  nlohmann::json histograms_json() const;
+  // Inverse of to_json() + histograms_json(); throws std::runtime_error
+  // naming the first missing or malformed key.
+  static Stats from_json(const nlohmann::json& stats, const nlohmann::json& histograms);
 };
+
+// Shard k of n (1 <= k <= n): the chunks c of every family and sweep value
+// with c % n == k - 1. Chunks are fixed (256 probes), so a shard judges the
+// same rays whatever the thread count, and the n shards together judge
+// exactly the rays of the unsharded run.
+struct Shard {
+  std::uint64_t k = 1, n = 1;
+};
+inline constexpr std::uint64_t kMaxShards = 1000000;
 
 struct Options {
   std::vector<std::string> families;  // empty: every family of the subjects' kinds
   long long rays = 20000;             // ray/primitive tests per family per subject
   std::uint64_t seed = 1;
   int threads = 0;                    // 0: all hardware threads
-  std::function<void(std::size_t done, std::size_t total)> progress;  // from any thread, serialised
+  std::optional<Shard> shard;         // unset: every ray
+  // Called after each chunk (from any thread, serialised) with the cases done
+  // and planned, counted as --rays counts them (ray/primitive tests per family).
+  std::function<void(std::uint64_t done, std::uint64_t total)> progress;
 };
 
 struct Cell {
@@ -132,10 +150,14 @@ struct Report {
   std::vector<std::string> subjects;  // "method/precision", triangles then spheres
   std::vector<std::string> kinds;     // "triangle" / "sphere", per subject
   std::vector<Cell> cells;            // subject-major, families and sweeps in order
+  std::optional<Shard> shard;         // set: a shard's partial counts (to_json adds
+                                      // "shard" and per-cell "histograms" for merging)
 
   Stats total(std::size_t subject) const;
   const Cell* worst(std::size_t subject) const;  // nullptr when nothing went wrong
   nlohmann::json to_json() const;
+  // Reads what to_json() wrote for a shard (throws std::runtime_error).
+  static Report from_json(const nlohmann::json& j);
   std::string summary_table() const;
   std::string to_csv() const;
 };
@@ -145,6 +167,18 @@ struct Report {
 // thread count: cases depend only on (seed, family, sweep, chunk).
 Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres,
            const Options& opt);
+
+// Grading answers computed elsewhere (`rayaudit audit --grade`): one probe is
+// a ray against `count` triangles (a group when count > 1: edge pair, vertex
+// fan, or a closed mesh when `closed`), with the subject's answer for each.
+// Books exactly as for a registered method of precision p: the oracle's
+// verdicts, t errors in ulps of p, leaks and double hits over the group.
+struct GivenAnswer {
+  bool hit = false;
+  double t = 0, u = 0, v = 0;  // u, v: barycentrics if given (only checked for NaN/inf)
+};
+void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given,
+                 int count, bool closed);
 
 // Every probe of a family with its exact answers, as the audit sees them
 // (for the export and for tests that check the families themselves).
@@ -157,5 +191,7 @@ std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std:
                                    long long rays);
 std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
                                      long long rays);
+// Probes per sweep value for a --rays budget (the unit of chunking).
+long long probes_per_sweep(const Family& f, int sweep, long long rays);
 
 }  // namespace ra::audit

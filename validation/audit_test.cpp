@@ -13,6 +13,7 @@
 #include "audit_gtest.h"
 #include "cases_csv.h"
 #include "errors.h"
+#include "grade.h"
 
 namespace {
 
@@ -310,6 +311,105 @@ TEST(AuditCasesCsv, HexAndDecimalFloatsAndIds) {
   EXPECT_EQ(cs[0].id, "bug-17");
   EXPECT_EQ(cs[0].tri.c, (ra::Vec3d{0, 1, 0}));
   EXPECT_EQ(ra::oracle::triangle(cs[0].ray, cs[0].tri.a, cs[0].tri.b, cs[0].tri.c).verdict, Verdict::hit);
+}
+
+// ------------------------------------------------------------ shards ---
+// Every cell's counts and t error histograms, as merge reads them.
+std::string cell_dump(const Cell& c) {
+  return c.family + "@" + c.sweep_label + " " + c.stats.to_json().dump() + c.stats.histograms_json().dump();
+}
+
+TEST(AuditShards, ShardsPartitionEveryFamilyAndSweepValue) {
+  const ra::Method* m = ra::find_method("moller");
+  const ra::Method* k = ra::find_method("kraus");
+  ASSERT_TRUE(m && k);
+  const std::vector<TriangleSubject> tris = {registry_triangle(*m, Precision::f32), registry_triangle(*m, Precision::f64)};
+  const std::vector<SphereSubject> sph = {registry_sphere(*k, Precision::f32)};
+  Options whole = opts({"random", "edge", "closed-mesh", "secondary", "huge"}, 30000, 4);
+  const Report all = run(tris, sph, whole);
+  std::vector<Report> parts;
+  for (std::uint64_t i = 1; i <= 3; ++i) {
+    Options o = whole;
+    o.shard = Shard{i, 3};
+    o.threads = int(i);  // the shard's rays do not depend on threads
+    parts.push_back(run(tris, sph, o));
+  }
+  ASSERT_EQ(parts[0].cells.size(), all.cells.size());
+  for (std::size_t c = 0; c < all.cells.size(); ++c) {
+    Stats sum;
+    for (const Report& p : parts) {
+      // Each shard judges about a third of every cell (whole chunks of 256 probes).
+      const double share = double(p.cells[c].stats.tests) / double(all.cells[c].stats.tests);
+      if (all.cells[c].family != "secondary")  // secondary: only the hits spawn
+        EXPECT_NEAR(share, 1.0 / 3, 0.15) << cell_dump(all.cells[c]);
+      sum.merge(p.cells[c].stats);
+    }
+    Cell merged = all.cells[c];
+    merged.stats = sum;
+    EXPECT_EQ(cell_dump(merged), cell_dump(all.cells[c]));
+  }
+  // A shard's JSON carries what merging needs; the whole run's does not.
+  const auto j = parts[1].to_json();
+  EXPECT_EQ(j["shard"]["k"], 2);
+  EXPECT_TRUE(j["cells"][0].contains("histograms"));
+  EXPECT_FALSE(all.to_json().contains("shard"));
+  EXPECT_FALSE(all.to_json()["cells"][0].contains("histograms"));
+}
+
+TEST(AuditShards, ShardReportsRoundTripThroughJson) {
+  const ra::Method* m = ra::find_method("moller");
+  Options o = opts({"random", "edge"}, 8000, 2);
+  o.shard = Shard{2, 2};
+  const Report r = run({registry_triangle(*m, Precision::f32)}, {}, o);
+  const Report back = Report::from_json(nlohmann::json::parse(r.to_json().dump(1)));
+  ASSERT_EQ(back.cells.size(), r.cells.size());
+  for (std::size_t c = 0; c < r.cells.size(); ++c) {
+    EXPECT_EQ(cell_dump(back.cells[c]), cell_dump(r.cells[c]));
+    EXPECT_EQ(back.cells[c].sweep, r.cells[c].sweep);
+  }
+  EXPECT_EQ(back.to_json().dump(), r.to_json().dump());
+  // A histogram that does not add up to t_samples is refused.
+  auto j = r.to_json();
+  j["cells"][0]["histograms"]["t_ulps"] = nlohmann::json::array();
+  EXPECT_THROW(Report::from_json(j), std::runtime_error);
+}
+
+// ------------------------------------------------------------- grade ---
+// Answers written by a registered method, graded as if they came from
+// another program, must book exactly what auditing that method books.
+TEST(AuditGrade, GradedAnswersOfAMethodEqualItsAudit) {
+  const ra::Method* m = ra::find_method("moller");
+  const std::vector<std::string> fams = {"random", "edge", "vertex", "near-miss", "closed-mesh"};
+  const auto dir = std::filesystem::temp_directory_path();
+  const auto cases_path = dir / "rayaudit_grade_cases.csv", answers_path = dir / "rayaudit_grade_answers.csv";
+  for (Precision p : {Precision::f32, Precision::f64}) {
+    const auto rows = export_rows(fams, p, 6, 3000);
+    std::string answers = "id,hit,t,u,v\n";
+    for (const ExportRow& r : rows) {
+      std::optional<ra::TriangleHit<double>> h;
+      if (p == Precision::f32) {
+        if (auto hf = m->tri_f.hit(ra::Rayf(r.ray), ra::Vec3f(r.tri.a), ra::Vec3f(r.tri.b), ra::Vec3f(r.tri.c), false))
+          h = ra::TriangleHit<double>{hf->t, hf->b1, hf->b2};
+      } else {
+        h = m->tri_d.hit(r.ray, r.tri.a, r.tri.b, r.tri.c, false);
+      }
+      char buf[160];
+      if (h) std::snprintf(buf, sizeof buf, "%s,true,%a,%a,%a\n", r.id.c_str(), h->t, h->b1, h->b2);
+      else std::snprintf(buf, sizeof buf, "%s,false,,,\n", r.id.c_str());
+      answers += buf;
+    }
+    { std::ofstream(cases_path) << cases_csv(rows); }
+    { std::ofstream(answers_path) << answers; }
+    const Report graded = grade_answers(answers_path.string(), cases_path.string(), p, "moller");
+    const Report audited = run({registry_triangle(*m, p)}, {}, opts(fams, 3000, 6));
+    EXPECT_EQ(graded.subjects, audited.subjects);
+    ASSERT_EQ(graded.cells.size(), audited.cells.size());
+    for (std::size_t c = 0; c < audited.cells.size(); ++c)
+      EXPECT_EQ(cell_dump(graded.cells[c]), cell_dump(audited.cells[c])) << precision_name(p);
+    EXPECT_GT(graded.total(0).groups, 500u);
+  }
+  std::filesystem::remove(cases_path);
+  std::filesystem::remove(answers_path);
 }
 
 }  // namespace

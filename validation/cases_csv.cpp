@@ -53,6 +53,12 @@ std::string hex(double x) {
 }  // namespace
 
 std::vector<UserCase> read_cases_csv(const std::string& path) {
+  std::vector<UserCase> cases;
+  for_each_case(path, [&](const UserCase& c, long) { cases.push_back(c); });
+  return cases;
+}
+
+void for_each_case(const std::string& path, const std::function<void(const UserCase&, long line)>& visit) {
   std::ifstream in(path);
   if (!in) throw InputError(located(path, 0, "cannot open the cases file"));
   std::string line;
@@ -77,7 +83,6 @@ std::vector<UserCase> read_cases_csv(const std::string& path) {
   for (std::size_t i = 0; i < header.size(); ++i)
     if (header[i] == "id") id_col = int(i);
 
-  std::vector<UserCase> cases;
   long row = 0;
   while (std::getline(in, line)) {
     ++lineno;
@@ -98,9 +103,8 @@ std::vector<UserCase> read_cases_csv(const std::string& path) {
     c.id = id_col < 0 ? std::to_string(row) : f[std::size_t(id_col)];
     c.ray = Rayd{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
     c.tri = {{v[6], v[7], v[8]}, {v[9], v[10], v[11]}, {v[12], v[13], v[14]}};
-    cases.push_back(c);
+    visit(c, lineno);
   }
-  return cases;
 }
 
 std::string cases_csv(const std::vector<ExportRow>& rows) {

@@ -8,6 +8,7 @@
 // is {o + t d : t >= 0}. The export writes id,family,sweep, the 15 inputs as
 // %a, then verdict and t (%a, empty when there is no crossing).
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,13 @@ struct UserCase {
 // Throws ra::InputError "FILE:LINE: what is wrong" on a missing file, a
 // missing column, a wrong field count or a bad number.
 std::vector<UserCase> read_cases_csv(const std::string& path);
+
+// The same parser, streaming: calls visit(case, line) for each data row in
+// file order, holding one row at a time, so memory does not grow with the
+// file (issue 15). Rows before a malformed one have been visited when it
+// throws: callers that must write nothing on bad input read twice (a first
+// pass with a no-op visitor).
+void for_each_case(const std::string& path, const std::function<void(const UserCase&, long line)>& visit);
 
 struct ExportRow {
   std::string id, family, sweep;

@@ -63,4 +63,17 @@ TEST(ExampleUserIntersector, WrapperAroundRegistryWatertightPasses) {
   EXPECT_WATERTIGHT(mine);
 }
 
+// A long audit spread over GoogleTest's shards: run with GTEST_TOTAL_SHARDS=N
+// and GTEST_SHARD_INDEX=0..N-1 (ctest does, per test; CI matrices can), each
+// shard judges its 1/N of the rays. Unsharded, it is one test judging them all.
+const bool kShardedExample = ra::audit::RegisterShardedAudit(
+    "ExampleShardedAudit", "NaiveLeaksInEveryShard", [](const ra::audit::Shard& shard) {
+      const auto mine = ra::audit::triangle_subject<float>("naive", naive);
+      const ra::audit::CheckOptions c{.families = {"edge"}, .rays = 60000, .shard = shard};
+      const ::testing::AssertionResult wt = ra::audit::IsWatertight(mine, c);
+      EXPECT_FALSE(wt);
+      std::printf("judged shard %llu/%llu: %s\n", (unsigned long long)shard.k, (unsigned long long)shard.n,
+                  wt.message());
+    });
+
 }  // namespace

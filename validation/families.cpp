@@ -514,11 +514,11 @@ std::string family_names() {
   return s;
 }
 
-std::uint64_t stream_seed(std::uint64_t seed, const std::string& family, int sweep, int chunk) {
+std::uint64_t stream_seed(std::uint64_t seed, const std::string& family, int sweep, std::uint64_t chunk) {
   std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the family name
   for (unsigned char ch : family) h = (h ^ ch) * 1099511628211ull;
   Rng g{seed ^ h};
-  g.s ^= (std::uint64_t(sweep) << 40) ^ std::uint64_t(chunk) * 0xD1B54A32D192ED03ull;
+  g.s ^= (std::uint64_t(sweep) << 40) ^ chunk * 0xD1B54A32D192ED03ull;
   return g.next();
 }
 

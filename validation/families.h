@@ -57,8 +57,10 @@ const Family* find_family(const std::string& name);
 std::string family_names();
 
 // A deterministic stream per (seed, family, sweep value, chunk): the same
-// cases whatever the thread count or which other families run.
-std::uint64_t stream_seed(std::uint64_t seed, const std::string& family, int sweep, int chunk);
+// cases whatever the thread count, shard or which other families run. The
+// chunk index is 64-bit (1e10 rays are ~4e7 chunks per sweep value); for
+// indices below 2^31 the streams are those of the former int version.
+std::uint64_t stream_seed(std::uint64_t seed, const std::string& family, int sweep, std::uint64_t chunk);
 
 // `count` probes of a triangle family. Cases are made in double; for f32 every
 // coordinate is then rounded to float, so the oracle judges what the float
