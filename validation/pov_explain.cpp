@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <iterator>
 #include <memory>
+#include <optional>
 
 #include "camera.h"
 #include "pov_mesh.h"
@@ -75,6 +78,14 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
   quiet.progress = false;
   RenderOptions pov_hit = quiet;
   pov_hit.pov_mesh_hit = true;
+  RenderOptions pov_isect = pov_hit;
+  pov_isect.pov_mesh_intersect = true;
+  RenderOptions pov_uv = pov_isect;
+  pov_uv.pov_mesh_uv = true;
+  RenderOptions pov_f32 = pov_uv;
+  pov_f32.float32_colour = true;
+  RenderOptions f32_only = quiet;
+  f32_only.float32_colour = true;
   struct Model {
     const char* cause;
     Scene scene;
@@ -92,9 +103,39 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
        "through its float32 Perp vector (shape/mesh.cpp); done so (with float32 mesh data and equal normals "
        "flat), our pixel equals POV-Ray's",
        as_pov_stores_it(scene, true, true), pov_hit},
+      {"mesh2 intersection: POV-Ray decides whether a ray meets a mesh2 triangle by projecting the point on its "
+       "float32 plane along the dominant axis of the normal and testing the three edges in 2D on the float32 "
+       "vertices (intersect_mesh_triangle), and its bounding-box tree search stops at the box entered after the "
+       "nearest hit, even a hit the caller then refuses as too close (a neighbouring triangle at t < 1e-3 hides the "
+       "rest of the mesh from a shadow ray) (shape/mesh.cpp); deciding every camera, reflected and shadow ray's "
+       "mesh hits so (with its hit point, float32 data and equal normals flat), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_isect},
+      {"mesh2 UV: POV-Ray computes a mesh2 hit's texture coordinates by its own projection onto the float32 "
+       "triangle sides (Mesh::UVCoord of shape/mesh.cpp), not with the smooth normal's weights; done so at its hit "
+       "point (with its inside test, float32 data and equal normals flat), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_uv},
+      {"float32 shading: POV-Ray keeps colours in float32 (RGBColour): the pigment, finish colours, light colours "
+       "and every product and sum of the shading rounded to float32 (trace.cpp); shaded so (with all the mesh2 "
+       "rules above), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_f32},
+      {"float32 shading: POV-Ray keeps colours in float32 (RGBColour): the pigment, finish colours, light colours "
+       "and every product and sum of the shading rounded to float32 (trace.cpp); shaded so, our pixel equals "
+       "POV-Ray's",
+       scene, f32_only},
   };
   std::vector<std::unique_ptr<Tracer>> model_tracers;
   for (const auto& m : models) model_tracers.push_back(std::make_unique<Tracer>(m.scene, m.options));
+  const Model cache_models[] = {
+      {"shadow cache: POV-Ray first re-tests the object that last blocked the light (one cache for camera-ray hits, "
+       "one for deeper ones), accepting t >= 1e-4 where the ordinary test wants t > 1e-3 (trace.cpp, "
+       "TracePointLightShadowRay); the image rendered so in POV's order, our pixel equals POV-Ray's",
+       scene, quiet},
+      {"shadow cache: POV-Ray first re-tests the object that last blocked the light, accepting t >= 1e-4 where the "
+       "ordinary test wants t > 1e-3 (trace.cpp); the image rendered so in POV's order, with every mesh2 rule and "
+       "float32 colours, our pixel equals POV-Ray's",
+       models[std::size(models) - 2].scene, models[std::size(models) - 2].options},
+  };
+  std::optional<Image> cache_images[std::size(cache_models)];
   const Tracer tracer(scene, quiet);
   const Camera camera(scene.camera, scene.width, scene.height);
   const unsigned m = c.bits == 16 ? 65535u : 255u;
@@ -103,9 +144,25 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
     for (std::size_t mi = 0; mi < model_tracers.size() && e.cause.empty(); ++mi) {
       const Color rc = model_tracers[mi]->pixel(d.x, d.y);
       const float rf[3] = {float(rc.x), float(rc.y), float(rc.z)};
+      if (std::getenv("RA_DEBUG_EXPLAIN"))
+        std::fprintf(stderr, "DEBUG (%d,%d) model %zu: %.6f %.6f %.6f pov %.6f %.6f %.6f\n", d.x, d.y, mi, rc.x * 255, rc.y * 255,
+                     rc.z * 255, pov.at(d.x, d.y)[0] * 255., pov.at(d.x, d.y)[1] * 255., pov.at(d.x, d.y)[2] * 255.);
       bool same = true;
       for (int ch = 0; ch < 3; ++ch) same &= quantize(rf[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
       if (same) e.cause = models[mi].cause;
+    }
+    // POV's shadow cache: the whole image rendered in POV's order with it
+    // (its state runs from pixel to pixel), alone and with every rule above.
+    for (std::size_t ci = 0; ci < std::size(cache_models) && e.cause.empty(); ++ci) {
+      if (!cache_images[ci]) {
+        RenderOptions o = cache_models[ci].options;
+        o.pov_shadow_cache = true;
+        cache_images[ci] = Tracer(cache_models[ci].scene, o).render();
+      }
+      bool same = true;
+      for (int ch = 0; ch < 3; ++ch)
+        same &= quantize(cache_images[ci]->at(d.x, d.y)[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
+      if (same) e.cause = cache_models[ci].cause;
     }
     if (e.cause.empty()) {
       // Our value within a few float32 ulps of a rounding boundary (k + 0.5) / max.
@@ -127,6 +184,23 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
     if (!e.cause.empty()) {
       out.push_back(e);
       continue;
+    }
+    if (std::getenv("RA_DEBUG_EXPLAIN")) {
+      Ray<double> r = camera.ray(d.x + 0.5, d.y + 0.5);
+      r.tmin = kPovMinIsectDepth;
+      if (const auto hit = tracer.intersect(r)) {
+        const Vec3d p = r.at(hit->t);
+        const auto sp = tracer.shading_point(r);
+        std::fprintf(stderr, "DEBUG hit object %d prim %d t %.17g n %g %g %g ng %g %g %g\n", hit->object, hit->prim, hit->t,
+                     sp->n.x, sp->n.y, sp->n.z, sp->ng.x, sp->ng.y, sp->ng.z);
+        for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+          const Vec3d lv = scene.lights[li].position - p;
+          const Ray<double> probe{p, normalize(lv), std::getenv("RA_TMIN") ? std::atof(std::getenv("RA_TMIN")) : 1e-9, length(lv)};
+          if (const auto b = tracer.intersect(probe))
+            std::fprintf(stderr, "DEBUG light %zu blocked by object %d prim %d at t %.9g b %.3g %.3g (dist %g), n.l %g\n", li, b->object,
+                         b->prim, b->t, b->b1, b->b2, length(lv), dot(sp->n, normalize(lv)));
+        }
+      }
     }
     // POV's shadow cache
     Ray<double> r = camera.ray(d.x + 0.5, d.y + 0.5);
