@@ -144,9 +144,6 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
     for (std::size_t mi = 0; mi < model_tracers.size() && e.cause.empty(); ++mi) {
       const Color rc = model_tracers[mi]->pixel(d.x, d.y);
       const float rf[3] = {float(rc.x), float(rc.y), float(rc.z)};
-      if (std::getenv("RA_DEBUG_EXPLAIN"))
-        std::fprintf(stderr, "DEBUG (%d,%d) model %zu: %.6f %.6f %.6f pov %.6f %.6f %.6f\n", d.x, d.y, mi, rc.x * 255, rc.y * 255,
-                     rc.z * 255, pov.at(d.x, d.y)[0] * 255., pov.at(d.x, d.y)[1] * 255., pov.at(d.x, d.y)[2] * 255.);
       bool same = true;
       for (int ch = 0; ch < 3; ++ch) same &= quantize(rf[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
       if (same) e.cause = models[mi].cause;
@@ -184,23 +181,6 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
     if (!e.cause.empty()) {
       out.push_back(e);
       continue;
-    }
-    if (std::getenv("RA_DEBUG_EXPLAIN")) {
-      Ray<double> r = camera.ray(d.x + 0.5, d.y + 0.5);
-      r.tmin = kPovMinIsectDepth;
-      if (const auto hit = tracer.intersect(r)) {
-        const Vec3d p = r.at(hit->t);
-        const auto sp = tracer.shading_point(r);
-        std::fprintf(stderr, "DEBUG hit object %d prim %d t %.17g n %g %g %g ng %g %g %g\n", hit->object, hit->prim, hit->t,
-                     sp->n.x, sp->n.y, sp->n.z, sp->ng.x, sp->ng.y, sp->ng.z);
-        for (std::size_t li = 0; li < scene.lights.size(); ++li) {
-          const Vec3d lv = scene.lights[li].position - p;
-          const Ray<double> probe{p, normalize(lv), std::getenv("RA_TMIN") ? std::atof(std::getenv("RA_TMIN")) : 1e-9, length(lv)};
-          if (const auto b = tracer.intersect(probe))
-            std::fprintf(stderr, "DEBUG light %zu blocked by object %d prim %d at t %.9g b %.3g %.3g (dist %g), n.l %g\n", li, b->object,
-                         b->prim, b->t, b->b1, b->b2, length(lv), dot(sp->n, normalize(lv)));
-        }
-      }
     }
     // POV's shadow cache
     Ray<double> r = camera.ray(d.x + 0.5, d.y + 0.5);
