@@ -108,8 +108,8 @@ void run_random(const Args& a) {
       const nlohmann::json small =
           ra::shrink_scene(j, ra::unexplained_pixel_persists(file, first->x, first->y, a.threads), 200, &tries);
       const fs::path small_file = fs::path(a.out_dir) / (name + ".json");
-      ra::write_text_atomically(fs::path(a.out_dir) / (name + ".original.json"), j.dump(2) + "\n");
-      ra::write_text_atomically(small_file, small.dump(2) + "\n");
+      ra::write_text_atomically(fs::path(a.out_dir) / (name + ".original.json"), ra::readable_json(j) + "\n");
+      ra::write_text_atomically(small_file, ra::readable_json(small) + "\n");
       std::cout << "; shrunk in " << tries << " tries to " << small_file.string();
       entry["minimal_scene"] = small_file.string();
       entry["original_scene"] = (fs::path(a.out_dir) / (name + ".original.json")).string();
@@ -227,7 +227,13 @@ void setup(CLI::App& app) {
   auto* random_opt = cmd->add_option("--random", args->random,
                   "Compare N random scenes (spheres, planes, triangles, corpus meshes), explaining every differing "
                   "pixel; exit 1 if any has no known cause");
-  auto* seed_opt = cmd->add_option("--seed", args->seed, "Seed of the --random batch (default 1)");
+  auto* seed_opt = cmd->add_option("--seed", args->seed, "Seed of the --random batch (default 1)")
+                       ->check(CLI::Validator(
+                           [](std::string& v) {
+                             return v.find('-') == std::string::npos ? std::string()
+                                                                     : "the seed is a non-negative integer";
+                           },
+                           "UINT64"));
   cmd->add_option("--out", args->out_dir,
                   "With --random: write each unexplained difference here as a minimal scene (shrunk), with "
                   "unexplained.json listing them");

@@ -32,8 +32,3 @@ foreach(scene ${RAYAUDIT_SCENES})
   set_tests_properties(golden/${name} PROPERTIES LABELS golden SKIP_RETURN_CODE 77 TIMEOUT 300)
 endforeach()
 
-# Differential testing (issue 18): a few random scenes (seed 7) compared with
-# POV-Ray 3.7, every differing pixel explained by --explain's hypotheses;
-# without the corpus cache the scenes hold spheres, planes and triangles only.
-add_test(NAME pov/random-seed7 COMMAND rayaudit compare --random 4 --seed 7 --threads 1)
-set_tests_properties(pov/random-seed7 PROPERTIES LABELS pov TIMEOUT 300)

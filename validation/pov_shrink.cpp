@@ -132,4 +132,20 @@ json shrink_scene(const json& scene, const PixelPersists& persists, int max_trie
   return best;
 }
 
+std::string readable_json(const json& j, int indent) {
+  const std::string flat = j.dump();
+  if (int(flat.size()) + indent <= 96 || !(j.is_object() || j.is_array()) || j.empty()) return flat;
+  const std::string pad(std::size_t(indent + 2), ' ');
+  std::string out = j.is_object() ? "{\n" : "[\n";
+  bool first = true;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!first) out += ",\n";
+    first = false;
+    out += pad;
+    if (j.is_object()) out += json(it.key()).dump() + ": ";
+    out += readable_json(*it, indent + 2);
+  }
+  return out + "\n" + std::string(std::size_t(indent), ' ') + (j.is_object() ? "}" : "]");
+}
+
 }  // namespace ra

@@ -43,4 +43,8 @@ std::vector<nlohmann::json> simplifications(const nlohmann::json& scene);
 nlohmann::json shrink_scene(const nlohmann::json& scene, const PixelPersists& persists, int max_tries = 200,
                             int* tries = nullptr);
 
+// A scene as text that reads in one screen: any value whose one-line form
+// fits in a line stays on one line, larger ones are indented.
+std::string readable_json(const nlohmann::json& j, int indent = 0);
+
 }  // namespace ra

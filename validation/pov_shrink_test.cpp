@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "pov_export.h"
 #include "random_scene.h"
 
@@ -75,6 +77,23 @@ TEST(Shrink, KeepsWhatThePixelNeedsAndDropsTheRest) {
   // Nothing more can go: every simplification of the result loses the pixel.
   for (const json& c : simplifications(small)) EXPECT_FALSE(holds(c)) << c.dump();
   EXPECT_GT(tries, 5);
+}
+
+// The minimal scene is written to read in one screen: short values on one
+// line, and it reads back as the same scene.
+TEST(Shrink, ReadableJsonIsShortAndTheSameScene) {
+  const json j = random_scene(3, 1);
+  const std::string text = readable_json(j);
+  EXPECT_EQ(json::parse(text), j);
+  auto count_lines = [](const std::string& t) { return int(std::count(t.begin(), t.end(), '\n')) + 1; };
+  EXPECT_LT(3 * count_lines(text), count_lines(j.dump(2))) << text;  // not one number per line
+  std::size_t longest = 0, start = 0;
+  for (std::size_t i = 0; i <= text.size(); ++i)
+    if (i == text.size() || text[i] == '\n') {
+      longest = std::max(longest, i - start);
+      start = i + 1;
+    }
+  EXPECT_LE(longest, 110u) << text;
 }
 
 }  // namespace
