@@ -396,6 +396,7 @@ struct Tracer::Impl {
   // and the error bound of the point for the normal-offset strategy.
   struct Surface {
     Vec3d p, ng, n, p_error;
+    int object = -1, prim = -1;  // the hit's
     const Material* material;
     bool has_uv = false;
     double u = 0, v = 0;
@@ -404,6 +405,8 @@ struct Tracer::Impl {
 
   Surface surface(const Ray<double>& ray, const SceneHit& h) const {
     Surface s;
+    s.object = h.object;
+    s.prim = h.prim;
     const Object& o = scene.objects[h.object];
     s.p = ray.at(h.t);
     switch (o.kind) {
@@ -574,9 +577,28 @@ struct Tracer::Impl {
   }
 
   // POV-Ray's trace: level 1 for camera rays; beyond max_depth, black.
-  Color trace(const Ray<double>& ray, int level, double weight) const {
+  // The closest hit of a ray leaving surface `from` (a reflected ray). With
+  // opt.skip_rounding_self_hits, a hit on that same primitive (which a ray
+  // leaving a plane, a sphere from outside or a triangle can only meet
+  // through the rounding of its origin) is skipped when it is nearer than
+  // that rounding allows: the origin's error along the normal (16 ulps of
+  // its largest coordinate) over the ray's cosine with the normal.
+  std::optional<SceneHit> intersect_from(Ray<double> ray, const Surface* from) const {
+    auto hit = intersect(ray);
+    if (!opt.skip_rounding_self_hits || !from) return hit;
+    while (hit && hit->object == from->object && hit->prim == from->prim) {
+      const double cos = std::abs(dot(from->ng, normalize(ray.d)));
+      const double bound = 16 * std::numeric_limits<double>::epsilon() * max_component(abs(ray.o)) / cos;
+      if (!(hit->t < bound)) break;
+      ray.tmin = std::nextafter(hit->t, std::numeric_limits<double>::infinity());
+      hit = intersect(ray);
+    }
+    return hit;
+  }
+
+  Color trace(const Ray<double>& ray, int level, double weight, const Surface* from = nullptr) const {
     if (level > scene.max_depth) return {0, 0, 0};
-    const auto hit = intersect(ray);
+    const auto hit = intersect_from(ray, from);
     if (!hit) return scene.background;
     Surface s = surface(ray, *hit);
     const Vec3d d = normalize(ray.d);
@@ -605,7 +627,7 @@ struct Tracer::Impl {
     }
     const double kr = max_component(m.reflection);
     if (kr > 0 && weight * kr >= scene.adc_bailout) {
-      const Color r = trace(reflected_ray(s, refl_dir), level + 1, weight * kr);
+      const Color r = trace(reflected_ray(s, refl_dir), level + 1, weight * kr, &s);
       out += mul(m.reflection, r);
     }
     return out;
@@ -645,7 +667,7 @@ struct Tracer::Impl {
     const Color refl = f(m.reflection);
     const double kr = max_component(refl);
     if (kr > 0 && weight * kr >= scene.adc_bailout) {
-      const Color r = f(trace(reflected_ray(s, refl_dir), level + 1, weight * kr));
+      const Color r = f(trace(reflected_ray(s, refl_dir), level + 1, weight * kr, &s));
       out = f(out + f(mul(refl, r)));
     }
     return out;

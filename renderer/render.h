@@ -52,6 +52,11 @@ struct RenderOptions {
   // order; pixel() alone is not meaningful. Double precision only. A
   // hypothesis for --explain.
   bool pov_shadow_cache = false;
+  // A reflected ray's hit on the very primitive it leaves, nearer than the
+  // rounding of its origin allows (a plane met again far out at a grazing
+  // angle), skipped: whether it happens is decided by the last bits of the
+  // hit point, which POV-Ray computes differently. A hypothesis for --explain.
+  bool skip_rounding_self_hits = false;
 };
 
 // What a ray hit: object index, primitive (triangle) index, t and the
