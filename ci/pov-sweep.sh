@@ -19,7 +19,7 @@ for obj in "$CACHE"/corpus/{ladder,assimp-obj,embree}/*.obj; do
   rc=0
   log="$(nice "$RAYAUDIT" compare "$obj" --accept-explained --json "$OUT/$name.json" --diff "$OUT/$name-diff.png" 2>&1)" || rc=$?
   case $rc in
-    0) compared=$((compared + 1)); echo "$name: $(printf '%s\n' "$log" | grep -E '^(identical|every differing)' | head -1)" ;;
+    0) compared=$((compared + 1)); echo "$name: $(printf '%s\n' "$log" | grep -E '^(identical: true|every differing)' | head -1)" ;;
     2) refused=$((refused + 1)); echo "$name: not a scene: $(printf '%s\n' "$log" | tail -1)" ;;
     *) compared=$((compared + 1)); failed=1; echo "$name: FAILED (exit $rc)"; printf '%s\n' "$log" | grep -E 'none of the known|error' | sed 's/^/  /' ;;
   esac
