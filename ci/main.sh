@@ -48,6 +48,12 @@ compare() {
 step "comparing with POV-Ray 3.7 into $OUT/pov (the dragon takes about 12 s: POV-Ray parses its 871k-triangle mesh2)"
 for scene in scenes/*.json scenes/corpus/*.json; do compare "$scene"; done
 
+step "differential test against POV-Ray: 12 random scenes, seed 1 (rayaudit compare --random; ci/nightly.sh runs 3 x 200)"
+echo "rayaudit compare --random 12 --seed 1 --out $OUT/pov-random"
+rc=0
+"$RAYAUDIT" compare --random 12 --seed 1 --out "$OUT/pov-random" 2>/dev/null | sed 's/^/  /' || rc=$?
+[ "$rc" = 0 ] || { echo "  FAILED: unexplained differences, minimal scenes in $OUT/pov-random"; failed=1; }
+
 step "checking the golden images (diffs into $OUT/golden-diffs)"
 "$RAYAUDIT" golden check --skip-unavailable --diff-dir "$OUT/golden-diffs" || { rc=$?; [ "$rc" = 77 ] || failed=1; }
 

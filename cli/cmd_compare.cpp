@@ -2,7 +2,14 @@
 // POV-Ray 3.7 at the same size, compares them (validation/image_compare.h)
 // and judges the result against the scene's tolerance, scenes/pov/NAME.json
 // (default: identical at 8 bits). Exit 1 when a difference is not explained.
+//
+// `rayaudit compare --random N --seed S [--out DIR]` (issue 18) does the same
+// on N random scenes (validation/random_scene.h), explaining every differing
+// pixel; a pixel no known cause explains is shrunk to a minimal scene
+// (validation/pov_shrink.h) written to DIR. Exit 1 if any remain.
+#include <fstream>
 #include <iostream>
+#include <map>
 
 #include "atomic_file.h"
 #include "command.h"
@@ -12,9 +19,12 @@
 #include "pov_explain.h"
 #include "pov_export.h"
 #include "pov_runner.h"
+#include "pov_shrink.h"
 #include "pov_tolerance.h"
+#include "random_scene.h"
 #include "render.h"
 #include "scene.h"
+#include "scene_mesh.h"
 
 namespace {
 
@@ -22,12 +32,108 @@ namespace {
 constexpr int kSkipped = 77;
 
 struct Args {
-  std::string scene, json_out, diff_out, ours_out, pov_out, tolerance;
-  int bits = 8, width = 0, height = 0, threads = 0;
-  bool keep = false, skip_inexpressible = false, explain = false;
+  std::string scene, json_out, diff_out, ours_out, pov_out, tolerance, out_dir;
+  int bits = 8, width = 0, height = 0, threads = 0, random = 0;
+  std::uint64_t seed = 1;
+  bool keep = false, skip_inexpressible = false, explain = false, accept_explained = false;
+  bool random_given = false, seed_given = false;
 };
 
+// The cause's name: its text up to the first colon ("float32", "shadow cache").
+std::string cause_name(const std::string& cause) { return cause.substr(0, cause.find(':')); }
+
+// One line per cause: how many pixels it explains.
+std::string cause_counts(const std::vector<ra::PixelExplanation>& pixels) {
+  std::map<std::string, int> n;
+  for (const auto& p : pixels)
+    if (!p.cause.empty()) ++n[cause_name(p.cause)];
+  std::string out;
+  for (const auto& [name, k] : n) out += (out.empty() ? "" : ", ") + name + " x" + std::to_string(k);
+  return out;
+}
+
+// --random: N scenes, each compared and explained; unexplained pixels shrunk
+// into DIR.
+void run_random(const Args& a) {
+  namespace fs = std::filesystem;
+  if (a.random < 1 || a.random > 100000) throw ra::InputError("--random must be between 1 and 100000");
+  if (!a.scene.empty()) throw ra::InputError("--random makes its own scenes: give no SCENE");
+  for (const auto& [flag, set] : std::vector<std::pair<const char*, bool>>{
+           {"--json", !a.json_out.empty()}, {"--diff", !a.diff_out.empty()}, {"--ours", !a.ours_out.empty()},
+           {"--pov", !a.pov_out.empty()}, {"--tolerance", !a.tolerance.empty()}, {"--width", a.width > 0},
+           {"--height", a.height > 0}, {"--bits", a.bits != 8}, {"--keep-pov-dir", a.keep},
+           {"--skip-inexpressible", a.skip_inexpressible}, {"--accept-explained", a.accept_explained}})
+    if (set) throw ra::InputError(std::string(flag) + " cannot be used with --random (it compares at 8 bits and explains every pixel)");
+  ra::find_povray();
+  if (ra::random_scene_meshes().empty())
+    std::cout << "note: no corpus meshes in " << ra::cache_dir().string()
+              << "/corpus (ci/fetch-corpus.sh): the scenes hold spheres, planes and triangles only\n";
+  if (!a.out_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(a.out_dir, ec);
+    if (ec || !fs::is_directory(a.out_dir)) throw ra::InputError(a.out_dir + ": cannot create the --out directory");
+    ra::check_output_path(fs::path(a.out_dir) / "unexplained.json");
+  }
+  int differed = 0, unexplained_scenes = 0;
+  std::map<std::string, int> causes;
+  nlohmann::json report = nlohmann::json::array();
+  for (int i = 0; i < a.random; ++i) {
+    const std::string name = "random-" + std::to_string(a.seed) + "-" + std::to_string(i);
+    const fs::path file = (a.out_dir.empty() ? fs::path(".") : fs::path(a.out_dir)) / (name + ".json");
+    const nlohmann::json j = ra::random_scene(a.seed, i);
+    const ra::Scene scene = ra::parse_scene_json(j.dump(), file);
+    const ra::ExplainedComparison r = ra::compare_and_explain(scene, a.threads);
+    for (const auto& p : r.pixels)
+      if (!p.cause.empty()) ++causes[cause_name(p.cause)];
+    if (r.differing == 0) {
+      std::cout << name << ": identical" << std::endl;
+      continue;
+    }
+    ++differed;
+    if (r.unexplained() == 0) {
+      std::cout << name << ": " << r.differing << " pixels differ, all explained (" << cause_counts(r.pixels) << ")"
+                << std::endl;
+      continue;
+    }
+    ++unexplained_scenes;
+    const ra::PixelExplanation* first = nullptr;
+    for (const auto& p : r.pixels)
+      if (p.cause.empty() && (!first || p.levels > first->levels)) first = &p;
+    std::cout << name << ": " << r.differing << " pixels differ, " << r.unexplained() << " unexplained (largest at ("
+              << first->x << ", " << first->y << "), " << first->levels << " levels)";
+    nlohmann::json entry = {{"scene", name}, {"x", first->x}, {"y", first->y}, {"levels", first->levels},
+                            {"unexplained_pixels", r.unexplained()}, {"differing_pixels", r.differing}};
+    if (!a.out_dir.empty()) {
+      int tries = 0;
+      const nlohmann::json small =
+          ra::shrink_scene(j, ra::unexplained_pixel_persists(file, first->x, first->y, a.threads), 200, &tries);
+      const fs::path small_file = fs::path(a.out_dir) / (name + ".json");
+      ra::write_text_atomically(fs::path(a.out_dir) / (name + ".original.json"), ra::readable_json(j) + "\n");
+      ra::write_text_atomically(small_file, ra::readable_json(small) + "\n");
+      std::cout << "; shrunk in " << tries << " tries to " << small_file.string();
+      entry["minimal_scene"] = small_file.string();
+      entry["original_scene"] = (fs::path(a.out_dir) / (name + ".original.json")).string();
+    }
+    std::cout << std::endl;
+    report.push_back(entry);
+  }
+  std::cout << "random scenes: " << a.random << " (seed " << a.seed << "), " << differed << " differed, "
+            << unexplained_scenes << " with unexplained pixels\n";
+  std::string counts;
+  for (const auto& [name, k] : causes) counts += (counts.empty() ? "" : ", ") + name + " x" + std::to_string(k);
+  if (!counts.empty()) std::cout << "explained pixels by cause: " << counts << "\n";
+  if (!a.out_dir.empty()) ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json", report.dump(2) + "\n");
+  if (unexplained_scenes > 0)
+    throw ra::CheckFailed(std::to_string(unexplained_scenes) + " random scenes have pixels no known cause explains" +
+                          (a.out_dir.empty() ? std::string(" (give --out DIR for minimal scenes)")
+                                             : "; minimal scenes in " + a.out_dir));
+}
+
 void run(const Args& a) {
+  if (a.random_given) return run_random(a);
+  if (a.scene.empty()) throw ra::InputError("compare needs a SCENE (or --random N)");
+  if (!a.out_dir.empty()) throw ra::InputError("--out goes with --random");
+  if (a.seed_given) throw ra::InputError("--seed goes with --random");
   if (a.bits != 8 && a.bits != 16) throw ra::InputError("--bits must be 8 or 16");
   if (a.skip_inexpressible)
     if (const auto missing = ra::missing_cache_inputs(a.scene); !missing.empty()) {
@@ -67,7 +173,7 @@ void run(const Args& a) {
   std::cout << "scene: " << a.scene << "\n" << ra::summary(c);
   for (const auto& line : v.lines) std::cout << line << "\n";
   std::vector<ra::PixelExplanation> explained;
-  if (a.explain && !c.differences.empty()) {
+  if ((a.explain || a.accept_explained) && !c.differences.empty()) {
     std::cout << "likely causes (--explain):\n";
     explained = ra::explain_differences(scene, ours, pov.image, c, opt);
     for (const auto& e : explained)
@@ -96,6 +202,17 @@ void run(const Args& a) {
     ra::write_text_atomically(a.json_out, j.dump(2) + "\n");
   }
   outputs.commit();  // also when the check fails: the diff and JSON say why
+  if (a.accept_explained) {
+    // Every differing pixel must have a known cause (the corpus sweep).
+    int unexplained = 0;
+    for (const auto& e : explained) unexplained += e.cause.empty();
+    if (unexplained > 0)
+      throw ra::CheckFailed(a.scene + ": " + std::to_string(unexplained) + " of " +
+                            std::to_string(c.differences.size()) + " differing pixels have no known cause");
+    std::cout << "every differing pixel explained: yes (" << c.differences.size() << " pixels"
+              << (explained.empty() ? "" : ": " + cause_counts(explained)) << ")\n";
+    return;
+  }
   if (!v.pass)
     throw ra::CheckFailed(a.scene + ": our render differs from POV-Ray's beyond what " +
                           (tol.file.empty() ? std::string("the default (identical at 8 bits)") : tol.file.string()) +
@@ -106,7 +223,23 @@ void run(const Args& a) {
 void setup(CLI::App& app) {
   auto args = std::make_shared<Args>();
   auto* cmd = app.add_subcommand("compare", "Render a scene with rayaudit and with POV-Ray 3.7 and compare them");
-  cmd->add_option("scene", args->scene, "Scene file (.json) or mesh (.obj)")->required();
+  cmd->add_option("scene", args->scene, "Scene file (.json) or mesh (.obj)");
+  auto* random_opt = cmd->add_option("--random", args->random,
+                  "Compare N random scenes (spheres, planes, triangles, corpus meshes), explaining every differing "
+                  "pixel; exit 1 if any has no known cause");
+  auto* seed_opt = cmd->add_option("--seed", args->seed, "Seed of the --random batch (default 1)")
+                       ->check(CLI::Validator(
+                           [](std::string& v) {
+                             return v.find('-') == std::string::npos ? std::string()
+                                                                     : "the seed is a non-negative integer";
+                           },
+                           "UINT64"));
+  cmd->add_option("--out", args->out_dir,
+                  "With --random: write each unexplained difference here as a minimal scene (shrunk), with "
+                  "unexplained.json listing them");
+  cmd->add_flag("--accept-explained", args->accept_explained,
+                "Pass when every differing pixel has a known cause (--explain), instead of judging by a tolerance "
+                "file (the corpus sweep)");
   cmd->add_option("--bits", args->bits, "Compare at 8 or 16 bits per channel (default 8)");
   cmd->add_option("--json", args->json_out, "Write the statistics as JSON");
   cmd->add_option("--diff", args->diff_out, "Write a false-colour difference image (.png)");
@@ -123,7 +256,11 @@ void setup(CLI::App& app) {
   cmd->add_flag("--skip-inexpressible", args->skip_inexpressible,
                 "Exit 77 (a skip for ctest) with the reason when POV-Ray cannot express the scene or a ${cache} "
                 "input is missing");
-  cmd->callback([args] { run(*args); });
+  cmd->callback([args, random_opt, seed_opt] {
+    args->random_given = random_opt->count() > 0;
+    args->seed_given = seed_opt->count() > 0;
+    run(*args);
+  });
 }
 
 ra::cli::Registrar reg(50, setup);

@@ -4,6 +4,7 @@
 #include "run_rayaudit.h"
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "image.h"
 
@@ -187,6 +189,31 @@ TEST(GoldenCli, CheckWithoutAGoldenFailsAndBlessRecordsOne) {
   EXPECT_NE(r.out.find("new golden"), std::string::npos) << r.out;
   r = run("golden check --root " + dir.string());
   EXPECT_EQ(r.code, 0) << r.out;
+  fs::remove_all(dir);
+}
+
+// compare --random: bad flags are one line and exit 2, nothing written.
+TEST(CompareRandomCli, RefusesBadFlagsWithOneLine) {
+  const fs::path dir = temp_dir("random-bad") / "out";
+  const std::vector<std::string> cases = {"--random 0", "--random 2 --seed -1", "--random 2 --json /tmp/x.json",
+                                         kSphereOnPlane + " --random 2", kSphereOnPlane + " --seed 3", kSphereOnPlane};
+  for (const std::string& args : cases) {
+    const auto r = ra::test::run_rayaudit("compare " + args + " --out " + dir.string());
+    EXPECT_EQ(r.code, 2) << args << ": " << r.all;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "unexplained.json")) << args;
+  }
+}
+
+// A small batch (real POV-Ray): every scene is compared, the batch is
+// reported, and with nothing unexplained the list in --out is empty.
+TEST(CompareRandomCli, SmallBatchIsComparedAndExplained) {
+  const fs::path dir = temp_dir("random");
+  const auto r = ra::test::run_rayaudit("compare --random 3 --seed 7 --threads 1 --out " + dir.string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  for (int i = 0; i < 3; ++i) EXPECT_NE(r.out.find("random-7-" + std::to_string(i) + ": "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("random scenes: 3 (seed 7)"), std::string::npos) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(read(dir / "unexplained.json")), nlohmann::json::array());
   fs::remove_all(dir);
 }
 

@@ -8,9 +8,23 @@ namespace {
 
 // POV-Ray's EPSILON (frame.h).
 constexpr double kPovEpsilon = 1e-10;
+// mesh.cpp's DEPTH_TOLERANCE, and MAX_DISTANCE (frame.h).
+constexpr double kPovMeshDepthTolerance = 1e-6;
+constexpr double kPovMaxDistance = 1e7;
 
 // max3_coordinate of mesh.cpp: ties go to the later axis.
 int max3_coordinate(double x, double y, double z) { return x > y ? (x > z ? 0 : 2) : (y > z ? 1 : 2); }
+
+// Compute_Mesh_Triangle's vertex swap of P1 and P2, decided on the float32
+// vertices and the dominant axis of the plane normal, so that the 2D edge
+// tests of intersect_mesh_triangle all face the same way.
+bool swapped(const Vec3d& p1, const Vec3d& p2, const Vec3d& p3) {
+  Vec3d s = cross(p3 - p1, p2 - p1);
+  s = s / length(s);  // POV takes the axis of the unit normal
+  const int dom = max3_coordinate(std::fabs(s.x), std::fabs(s.y), std::fabs(s.z));
+  const int i = dom == 0 ? 1 : 0, j = dom == 2 ? 1 : 2;
+  return (p2[i] - p3[i]) * (p2[j] - p1[j]) < (p2[j] - p3[j]) * (p2[i] - p1[i]);
+}
 
 }  // namespace
 
@@ -66,6 +80,55 @@ PovMeshHit pov_mesh_hit(const Ray<double>& r, const Vec3d& a, const Vec3d& b, co
   out.b1 = swap ? w1 : w2;
   out.b2 = w3;
   return out;
+}
+
+std::array<double, 2> pov_mesh_uv(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                                  const std::array<double, 2>& ua, const std::array<double, 2>& ub,
+                                  const std::array<double, 2>& uc) {
+  Vec3d p1 = to_float32(a), p2 = to_float32(b), p3 = to_float32(c);
+  std::array<double, 2> uv1{to_float32(ua[0]), to_float32(ua[1])}, uv2{to_float32(ub[0]), to_float32(ub[1])},
+      uv3{to_float32(uc[0]), to_float32(uc[1])};
+  if (swapped(p1, p2, p3)) {
+    std::swap(p1, p2);
+    std::swap(uv1, uv2);
+  }
+  // Data->Vertices[i] - Data->Vertices[j] is a float32 subtraction.
+  auto fsub = [](const Vec3d& x, const Vec3d& y) { return to_float32(x - y); };
+  // The weight of vertex pa, whose opposite side runs pb -> pc.
+  auto weight = [&](const Vec3d& pa, const Vec3d& pb, const Vec3d& pc) {
+    const Vec3d side1 = fsub(pc, pb), side2 = fsub(pc, pa);
+    const Vec3d va = p - pa;
+    const double k = dot(side2, side1) / dot(side1, side1);
+    const Vec3d vb = side1 * k - side2;
+    return 1 + dot(va, vb) / dot(vb, vb);
+  };
+  const double w1 = weight(p1, p2, p3), w2 = weight(p2, p1, p3), w3 = weight(p3, p1, p2);
+  return {w1 * uv1[0] + w2 * uv2[0] + w3 * uv3[0], w1 * uv1[1] + w2 * uv2[1] + w3 * uv3[1]};
+}
+
+std::optional<double> pov_mesh_intersect(const Ray<double>& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  // Compute_Mesh_Triangle, as in pov_mesh_hit.
+  Vec3d p1 = to_float32(a), p2 = to_float32(b), p3 = to_float32(c);
+  Vec3d s = cross(p3 - p1, p2 - p1);
+  const double len = length(s);
+  if (len == 0) return std::nullopt;  // POV drops degenerate triangles
+  s = s / len;
+  const double distance = to_float32(-dot(s, p1));
+  const Vec3d sf = to_float32(s);
+  const int dom = max3_coordinate(std::fabs(s.x), std::fabs(s.y), std::fabs(s.z));
+  const int i = dom == 0 ? 1 : 0, j = dom == 2 ? 1 : 2;
+  if ((p2[i] - p3[i]) * (p2[j] - p1[j]) < (p2[j] - p3[j]) * (p2[i] - p1[i])) std::swap(p1, p2);
+
+  // intersect_mesh_triangle.
+  const double nd = dot(sf, r.d);
+  if (std::fabs(nd) < kPovEpsilon) return std::nullopt;
+  const double t = -(distance + dot(sf, r.o)) / nd;
+  if (t < kPovMeshDepthTolerance || t > kPovMaxDistance) return std::nullopt;
+  const double u = r.o[i] + t * r.d[i], v = r.o[j] + t * r.d[j];
+  if ((p2[i] - u) * (p2[j] - p1[j]) < (p2[j] - v) * (p2[i] - p1[i])) return std::nullopt;
+  if ((p3[i] - u) * (p3[j] - p2[j]) < (p3[j] - v) * (p3[i] - p2[i])) return std::nullopt;
+  if ((p1[i] - u) * (p1[j] - p3[j]) < (p1[j] - v) * (p1[i] - p3[i])) return std::nullopt;
+  return t;
 }
 
 }  // namespace ra

@@ -19,6 +19,9 @@
 // that moves N.L by 1e-6 to 1e-4, enough to cross an 8-bit rounding boundary:
 // measured on corpus/ladder-100k-bunny (scenes/corpus/pov/).
 #pragma once
+#include <array>
+#include <optional>
+
 #include "ray.h"
 #include "vec.h"
 
@@ -34,5 +37,27 @@ struct PovMeshHit {
 // face_indices, as POV-Ray computes it. The vertices are rounded to float32
 // here (as POV stores them). The triangle must not be degenerate.
 PovMeshHit pov_mesh_hit(const Ray<double>& r, const Vec3d& a, const Vec3d& b, const Vec3d& c);
+
+// Does the ray meet triangle (a, b, c) by POV-Ray's own mesh2 test
+// (intersect_mesh_triangle of mesh.cpp), and at which t? The depth comes from
+// the float32 plane (as above), must lie in [1e-6, 1e7] (its DEPTH_TOLERANCE
+// and MAX_DISTANCE), and the point O + t Dir is kept when it lies inside the
+// triangle projected along the plane normal's dominant axis: three 2D edge
+// tests on the float32 vertices (after the vertex swap), each `<` rejecting,
+// so a point on an edge is inside. Unlike an edge test on the vertices in 3D,
+// this point is off the vertices' plane by the float32 plane's rounding, and
+// near an edge the two answers can differ. The ray's own window is not
+// applied (callers do). nullopt: a miss, or a degenerate triangle.
+// The texture coordinates POV-Ray gives point p of triangle (a, b, c) with
+// UVs (ua, ub, uc): Mesh::UVCoord, which weighs each vertex by projecting
+// P - vertex onto the perpendicular of the opposite side, the sides taken as
+// float32 differences of the float32 vertices (after the vertex swap):
+// the barycentric weights in exact arithmetic, but rounded differently from
+// the Perp interpolation used for normals and from ours.
+std::array<double, 2> pov_mesh_uv(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                                  const std::array<double, 2>& ua, const std::array<double, 2>& ub,
+                                  const std::array<double, 2>& uc);
+
+std::optional<double> pov_mesh_intersect(const Ray<double>& r, const Vec3d& a, const Vec3d& b, const Vec3d& c);
 
 }  // namespace ra

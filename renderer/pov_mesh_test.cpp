@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <utility>
 
 namespace ra {
 namespace {
@@ -101,6 +103,42 @@ TEST(PovMesh, WeightsDoNotDependOnTheVertexSwap) {
 TEST(PovMesh, ParallelRayIsNoHit) {
   const Ray<double> r{{0, 0, 1}, {1, 0, 0}};
   EXPECT_FALSE(pov_mesh_hit(r, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}).ok);
+}
+
+// POV's mesh2 test: a point on an edge is inside (each edge test rejects
+// only `<`), one beyond the edge is not, in either vertex order (the swap
+// makes the edge tests face the same way).
+TEST(PovMesh, InsideTestKeepsEdgesAndRejectsOutside) {
+  const Vec3d a{0, 0, 0}, b{4, 0, 0}, c{0, 4, 0};
+  const Ray<double> on_edge{{2, 0, 5}, {0, 0, -1}};  // meets the edge a-b at (2, 0, 0)
+  const Ray<double> outside{{2, -0.001, 5}, {0, 0, -1}};
+  const Ray<double> inside{{1, 1, 5}, {0, 0, -1}};
+  for (bool swap : {false, true}) {
+    const Vec3d& p = swap ? b : a;
+    const Vec3d& q = swap ? a : b;
+    ASSERT_TRUE(pov_mesh_intersect(inside, p, q, c).has_value());
+    EXPECT_EQ(*pov_mesh_intersect(inside, p, q, c), 5.0);
+    EXPECT_TRUE(pov_mesh_intersect(on_edge, p, q, c).has_value());
+    EXPECT_FALSE(pov_mesh_intersect(outside, p, q, c).has_value());
+  }
+  // Behind the origin, closer than POV's 1e-6, or degenerate: no hit.
+  EXPECT_FALSE(pov_mesh_intersect(Ray<double>{{1, 1, -1}, {0, 0, -1}}, a, b, c).has_value());
+  EXPECT_FALSE(pov_mesh_intersect(Ray<double>{{1, 1, 1e-7}, {0, 0, -1}}, a, b, c).has_value());
+  EXPECT_FALSE(pov_mesh_intersect(inside, a, b, Vec3d{8, 0, 0}).has_value());
+}
+
+// Mesh::UVCoord gives each vertex its own UV and the centroid their mean.
+TEST(PovMesh, UvAtVerticesAndCentroid) {
+  const Vec3d a{0, 0, 0}, b{3, 0, 0}, c{0, 2, 1};
+  const std::array<double, 2> ua{0.25, 0.5}, ub{0.75, 0.125}, uc{0.5, 1};
+  for (const auto& [p, want] : {std::pair{a, ua}, std::pair{b, ub}, std::pair{c, uc}}) {
+    const auto uv = pov_mesh_uv(p, a, b, c, ua, ub, uc);
+    EXPECT_NEAR(uv[0], want[0], 1e-15);
+    EXPECT_NEAR(uv[1], want[1], 1e-15);
+  }
+  const auto mid = pov_mesh_uv((a + b + c) / 3.0, a, b, c, ua, ub, uc);
+  EXPECT_NEAR(mid[0], 0.5, 1e-15);
+  EXPECT_NEAR(mid[1], 1.625 / 3, 1e-15);
 }
 
 }  // namespace

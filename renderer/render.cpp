@@ -110,6 +110,8 @@ struct Tracer::Impl {
     if (o.samples_per_axis < 1 || o.samples_per_axis > 16)
       throw InputError("samples per axis must be between 1 and 16");
     mesh_index.assign(s.objects.size(), -1);
+    shadow_cache_level1.assign(s.lights.size(), -1);
+    shadow_cache_other.assign(s.lights.size(), -1);
     for (std::size_t i = 0; i < s.objects.size(); ++i) {
       if (s.objects[i].kind != Object::Kind::mesh) continue;
       mesh_index[i] = int(opt.use_double ? meshes_d.size() : meshes_f.size());
@@ -228,7 +230,7 @@ struct Tracer::Impl {
   // Closest hit at precision T. The ray arrives in double (shading is done in
   // double); the kernels see it converted to T.
   template <class T>
-  std::optional<SceneHit> closest(const Ray<double>& rd) const {
+  std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1) const {
     const Ray<T> r(rd);
     SceneHit best;
     best.t = std::numeric_limits<double>::infinity();
@@ -240,6 +242,7 @@ struct Tracer::Impl {
       }
     };
     for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
+      if (only >= 0 && int(oi) != only) continue;
       const Object& o = scene.objects[oi];
       switch (o.kind) {
         case Object::Kind::sphere: {
@@ -255,6 +258,11 @@ struct Tracer::Impl {
         case Object::Kind::mesh: {
           const auto& m = meshes<T>()[mesh_index[oi]];
           const auto& k = tri_method->triangle<T>();
+          if (opt.pov_mesh_intersect) {
+            for (const SceneHit& h : pov_mesh_hits(rd, m))
+              if (h.t >= double(window.tmin) && h.t <= double(window.tmax)) consider(h.t, int(oi), h.prim, h.b1, h.b2);
+            break;
+          }
           if (opt.accel == Accel::bvh) {
             traverse(m.bvh, window, window.tmax, [&](std::uint32_t slot) {
               if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
@@ -279,6 +287,66 @@ struct Tracer::Impl {
     return best;
   }
 
+  // The hits of a mesh that POV-Ray's mesh2 reports for a ray (before any
+  // window but its own t >= 1e-6), with POV's barycentrics: each triangle by
+  // its own test (pov_mesh_intersect), and only those its bounding-box tree
+  // reaches (Mesh::intersect_bbox_tree). That search takes boxes in the
+  // order the ray enters them and stops at the first box entered beyond the
+  // nearest hit so far, so a triangle whose own box the ray enters after
+  // that hit is never tested, whatever the caller then rejects: a
+  // neighbouring triangle met at t = 1e-4 from a shadow ray's origin (then
+  // refused by the shadow test's t > 1e-3) hides the rest of the mesh. The
+  // order does not depend on the tree: a box's children are entered no
+  // earlier than it, so the leaves come out by their own entry depth.
+  template <class T>
+  std::vector<SceneHit> pov_mesh_hits(const Ray<double>& r, const PreparedMesh<T>& m) const {
+    const TriangleSet& set = *m.set;
+    struct Candidate {
+      double entry;
+      SceneHit hit;
+    };
+    std::vector<Candidate> found;
+    auto test = [&](int prim) {
+      const MeshTriangle3& tri = set.triangles[prim];
+      const Vec3d &a = set.positions[tri.v[0]], &b = set.positions[tri.v[1]], &c = set.positions[tri.v[2]];
+      const auto t = pov_mesh_intersect(r, a, b, c);
+      if (!t) return;
+      const PovMeshHit ph = pov_mesh_hit(r, a, b, c);
+      found.push_back({box_entry(r, to_float32(a), to_float32(b), to_float32(c)), SceneHit{*t, -1, prim, ph.b1, ph.b2}});
+    };
+    if (opt.accel == Accel::bvh) {
+      const Ray<double> all{r.o, r.d, 0.0, std::numeric_limits<double>::infinity()};
+      traverse(m.bvh, all, all.tmax, [&](std::uint32_t slot) {
+        test(int(m.bvh.order[slot]));
+        return false;
+      });
+    } else {
+      for (std::size_t i = 0; i < set.triangles.size(); ++i) test(int(i));
+    }
+    std::sort(found.begin(), found.end(), [](const Candidate& x, const Candidate& y) { return x.entry < y.entry; });
+    std::vector<SceneHit> out;
+    double best = std::numeric_limits<double>::infinity();
+    for (const Candidate& c : found) {
+      if (c.entry > best) break;
+      out.push_back(c.hit);
+      best = std::min(best, c.hit.t);
+    }
+    return out;
+  }
+
+  // Where the ray enters the bounding box of a triangle (slabs; negative
+  // when it starts inside).
+  static double box_entry(const Ray<double>& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    const Vec3d lo = vmin(a, vmin(b, c)), hi = vmax(a, vmax(b, c));
+    double entry = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) {
+      if (r.d[k] == 0) continue;
+      const double t0 = (lo[k] - r.o[k]) / r.d[k], t1 = (hi[k] - r.o[k]) / r.d[k];
+      entry = std::max(entry, std::min(t0, t1));
+    }
+    return entry;
+  }
+
   // Is anything in the ray's window? (shadow rays)
   template <class T>
   bool occluded(const Ray<T>& r) const {
@@ -294,6 +362,11 @@ struct Tracer::Impl {
         case Object::Kind::mesh: {
           const auto& m = meshes<T>()[mesh_index[oi]];
           const auto& k = tri_method->triangle<T>();
+          if (opt.pov_mesh_intersect) {
+            for (const SceneHit& h : pov_mesh_hits(Ray<double>(r), m))
+              if (h.t >= double(r.tmin) && h.t <= double(r.tmax)) return true;
+            break;
+          }
           if (opt.accel == Accel::bvh) {
             bool hit = false;
             traverse(m.bvh, r, r.tmax, [&](std::uint32_t slot) {
@@ -323,6 +396,7 @@ struct Tracer::Impl {
   // and the error bound of the point for the normal-offset strategy.
   struct Surface {
     Vec3d p, ng, n, p_error;
+    int object = -1, prim = -1;  // the hit's
     const Material* material;
     bool has_uv = false;
     double u = 0, v = 0;
@@ -331,6 +405,8 @@ struct Tracer::Impl {
 
   Surface surface(const Ray<double>& ray, const SceneHit& h) const {
     Surface s;
+    s.object = h.object;
+    s.prim = h.prim;
     const Object& o = scene.objects[h.object];
     s.p = ray.at(h.t);
     switch (o.kind) {
@@ -384,6 +460,11 @@ struct Tracer::Impl {
           s.has_uv = true;
           s.u = ta[0] + (tb[0] - ta[0]) * b1 + (tc[0] - ta[0]) * b2;
           s.v = ta[1] + (tb[1] - ta[1]) * b1 + (tc[1] - ta[1]) * b2;
+          if (opt.pov_mesh_hit && opt.pov_mesh_uv) {
+            const auto uv = pov_mesh_uv(s.p, a, b, c, ta, tb, tc);
+            s.u = uv[0];
+            s.v = uv[1];
+          }
         }
         s.material = &set.materials[std::clamp(tri.material, 0, int(set.materials.size()) - 1)];
         if (s.has_uv && s.material->bump)
@@ -427,7 +508,8 @@ struct Tracer::Impl {
   Color pigment(const Surface& s) const {
     const Material& m = *s.material;
     if (m.texture && s.has_uv)
-      if (const Texture* t = textures.find(m.texture->file)) return t->sample(s.u, s.v, m.texture->filter);
+      if (const Texture* t = textures.find(m.texture->file))
+        return t->sample(s.u + opt.uv_offset[0], s.v + opt.uv_offset[1], m.texture->filter);
     return m.color;
   }
 
@@ -452,6 +534,31 @@ struct Tracer::Impl {
       s.n = ra::bump_pov(s.n, *t, m.bump->filter, m.bump->strength, s.u, s.v);
   }
 
+  // POV-Ray's shadow cache (trace.cpp, TracePointLightShadowRay): per light,
+  // the object that last fully shadowed a point, one cache for camera-ray
+  // hits (level 1) and one for deeper ones; a level-1 test without a level-1
+  // entry uses the other. The cached object is tested first, alone, over
+  // [1e-4, dist] instead of (1e-3, dist - 1e-3); the ordinary test's closest
+  // blocker becomes the entry. State carried from pixel to pixel, so only
+  // render() in POV's order (one thread) reproduces POV.
+  mutable std::vector<int> shadow_cache_level1, shadow_cache_other;
+
+  bool shadowed_pov_cache(const Surface& s, const Vec3d& to_light, double dist, int level, std::size_t li) const {
+    int& level1 = shadow_cache_level1[li];
+    int& other = shadow_cache_other[li];
+    const int cached = (level == 1 && level1 >= 0) ? level1 : other;
+    if (cached >= 0 && closest<double>(Ray<double>{s.p, to_light, kPovMinIsectDepth, dist}, cached)) return true;
+    const auto h = closest<double>(Ray<double>{s.p, to_light, kPovShadowTolerance, dist - kPovShadowTolerance});
+    if (!h) return false;
+    (level == 1 ? level1 : other) = h->object;
+    return true;
+  }
+
+  bool shadowed(const Surface& s, const Vec3d& to_light, double dist, int level, std::size_t li) const {
+    if (opt.pov_shadow_cache) return shadowed_pov_cache(s, to_light, dist, level, li);
+    return shadowed(s, to_light, dist);
+  }
+
   bool shadowed(const Surface& s, const Vec3d& to_light, double dist) const {
     if (opt.use_double) {
       const Ray<double> r = spawn_ray<double>(opt.self_intersection, s.p, s.p_error, s.ng, to_light, true, dist);
@@ -471,9 +578,28 @@ struct Tracer::Impl {
   }
 
   // POV-Ray's trace: level 1 for camera rays; beyond max_depth, black.
-  Color trace(const Ray<double>& ray, int level, double weight) const {
+  // The closest hit of a ray leaving surface `from` (a reflected ray). With
+  // opt.skip_rounding_self_hits, a hit on that same primitive (which a ray
+  // leaving a plane, a sphere from outside or a triangle can only meet
+  // through the rounding of its origin) is skipped when it is nearer than
+  // that rounding allows: the origin's error along the normal (16 ulps of
+  // its largest coordinate) over the ray's cosine with the normal.
+  std::optional<SceneHit> intersect_from(Ray<double> ray, const Surface* from) const {
+    auto hit = intersect(ray);
+    if (!opt.skip_rounding_self_hits || !from) return hit;
+    while (hit && hit->object == from->object && hit->prim == from->prim) {
+      const double cos = std::abs(dot(from->ng, normalize(ray.d)));
+      const double bound = 16 * std::numeric_limits<double>::epsilon() * max_component(abs(ray.o)) / cos;
+      if (!(hit->t < bound)) break;
+      ray.tmin = std::nextafter(hit->t, std::numeric_limits<double>::infinity());
+      hit = intersect(ray);
+    }
+    return hit;
+  }
+
+  Color trace(const Ray<double>& ray, int level, double weight, const Surface* from = nullptr) const {
     if (level > scene.max_depth) return {0, 0, 0};
-    const auto hit = intersect(ray);
+    const auto hit = intersect_from(ray, from);
     if (!hit) return scene.background;
     Surface s = surface(ray, *hit);
     const Vec3d d = normalize(ray.d);
@@ -481,17 +607,19 @@ struct Tracer::Impl {
     if (dot(s.n, d) > 0) s.n = -s.n;  // POV flips the normal to face the ray
     bump_pov_after_flip(s);
     const Material& m = *s.material;
+    if (opt.float32_colour) return shade_float32(s, d, level, weight);
     const Color c = pigment(s);
     Color out = mul(mul(c, m.ambient), scene.ambient_light);
     const Vec3d refl_dir = d - s.n * (2 * dot(d, s.n));
-    for (const auto& light : scene.lights) {
+    for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+      const PointLight& light = scene.lights[li];
       const Vec3d lv = light.position - s.p;
       const double dist = length(lv);
       if (!(dist > 0)) continue;
       const Vec3d l = lv / dist;
       const double nl = dot(s.n, l);
       if (nl < kMinCosIncidence) continue;
-      if (shadowed(s, l, dist)) continue;
+      if (shadowed(s, l, dist, level, li)) continue;
       out += mul(c, light.color) * (m.diffuse * nl);
       if (m.phong > 0) {
         const double rl = dot(refl_dir, l);
@@ -500,8 +628,48 @@ struct Tracer::Impl {
     }
     const double kr = max_component(m.reflection);
     if (kr > 0 && weight * kr >= scene.adc_bailout) {
-      const Color r = trace(reflected_ray(s, refl_dir), level + 1, weight * kr);
+      const Color r = trace(reflected_ray(s, refl_dir), level + 1, weight * kr, &s);
       out += mul(m.reflection, r);
+    }
+    return out;
+  }
+
+  // The same shading with POV-Ray 3.7's float32 colours (trace.cpp): its
+  // RGBColour is float, so the pigment, the finish's colours and the light
+  // colours are stored as float32 and each product or sum of colours is
+  // rounded to float32; scalar factors (N.L times diffuse, the phong power)
+  // are double until they multiply a colour.
+  Color shade_float32(const Surface& s, const Vec3d& d, int level, double weight) const {
+    const Material& m = *s.material;
+    auto f = [](const Color& x) { return to_float32(x); };
+    const Color c = f(pigment(s));
+    // tmpCol += layCol * Ambient * ambientLight * att
+    Color out = f(f(f(mul(c, f(m.ambient))) * 1.0));
+    out = f(mul(out, f(scene.ambient_light)));
+    const Vec3d refl_dir = d - s.n * (2 * dot(d, s.n));
+    const double diffuse = to_float32(m.diffuse), phong = to_float32(m.phong), phong_size = to_float32(m.phong_size);
+    for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+      const PointLight& light = scene.lights[li];
+      const Vec3d lv = light.position - s.p;
+      const double dist = length(lv);
+      if (!(dist > 0)) continue;
+      const Vec3d l = lv / dist;
+      const double nl = dot(s.n, l);
+      if (nl < kMinCosIncidence) continue;
+      if (shadowed(s, l, dist, level, li)) continue;
+      const Color lc = f(light.color);
+      // colour += intensity * layer_pigment_colour * light_colour
+      out = f(out + f(mul(f(c * (nl * diffuse)), lc)));
+      if (phong > 0) {
+        const double rl = dot(refl_dir, l);
+        if (rl > 0) out = f(out + f(lc * (phong * std::pow(rl, phong_size))));
+      }
+    }
+    const Color refl = f(m.reflection);
+    const double kr = max_component(refl);
+    if (kr > 0 && weight * kr >= scene.adc_bailout) {
+      const Color r = f(trace(reflected_ray(s, refl_dir), level + 1, weight * kr, &s));
+      out = f(out + f(mul(refl, r)));
     }
     return out;
   }
@@ -541,6 +709,13 @@ Image Tracer::render() const {
   const int tiles_x = (s.width + kTile - 1) / kTile, tiles_y = (s.height + kTile - 1) / kTile;
   const int tiles = tiles_x * tiles_y;
   int threads = impl_->opt.threads > 0 ? impl_->opt.threads : int(std::thread::hardware_concurrency());
+  if (impl_->opt.pov_shadow_cache) {
+    // POV's order with +WT1: 32 x 32 blocks row by row, each row by row,
+    // all on one thread, the caches starting empty.
+    threads = 1;
+    impl_->shadow_cache_level1.assign(s.lights.size(), -1);
+    impl_->shadow_cache_other.assign(s.lights.size(), -1);
+  }
   threads = std::clamp(threads, 1, std::max(1, tiles));
   std::atomic<int> next{0}, done{0};
   // Each pixel depends only on its own rays, so any thread may take any

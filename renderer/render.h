@@ -1,6 +1,7 @@
 // The reference tracer: POV-Ray 3.7's shading model (../shared/POVRAY.md)
 // over any registered intersection method, in float or double.
 #pragma once
+#include <array>
 #include <memory>
 #include <string>
 
@@ -31,6 +32,36 @@ struct RenderOptions {
   // triangle is hit is still decided by the triangle method. A hypothesis for
   // rayaudit compare --explain, not a way to render.
   bool pov_mesh_hit = false;
+  // Decide which mesh triangle a ray meets by POV-Ray 3.7's own mesh2 test
+  // (renderer/pov_mesh.h: dominant-axis projection on float32 data) and its
+  // bounding-box tree search (which stops at the nearest hit, even one the
+  // ray's window then refuses) instead of the triangle method, for camera,
+  // reflected and shadow rays alike. A hypothesis for --explain.
+  bool pov_mesh_intersect = false;
+  // With pov_mesh_hit: texture coordinates as POV-Ray's Mesh::UVCoord
+  // computes them (renderer/pov_mesh.h), not interpolated with the normal's
+  // weights. A hypothesis for --explain.
+  bool pov_mesh_uv = false;
+  // Colours in float32 as POV-Ray 3.7 keeps them (RGBColour is float; see
+  // trace.cpp): the pigment, the finish's coefficients, the light colours and
+  // every product and sum of the shading rounded to float32, in POV's order.
+  // A hypothesis for --explain.
+  bool float32_colour = false;
+  // POV-Ray's shadow cache (../shared/POVRAY.md): the object that last
+  // blocked a light is tested first, accepting t >= 1e-4. Its state runs
+  // from pixel to pixel, so render() then runs on one thread in POV's +WT1
+  // order; pixel() alone is not meaningful. Double precision only. A
+  // hypothesis for --explain.
+  bool pov_shadow_cache = false;
+  // A reflected ray's hit on the very primitive it leaves, nearer than the
+  // rounding of its origin allows (a plane met again far out at a grazing
+  // angle), skipped: whether it happens is decided by the last bits of the
+  // hit point, which POV-Ray computes differently. A hypothesis for --explain.
+  bool skip_rounding_self_hits = false;
+  // Added to every texture lookup's (u, v): --explain moves lookups by less
+  // than POV-Ray's float32 mesh data can place them, to show a pixel decided
+  // below that precision. Zero to render.
+  std::array<double, 2> uv_offset{0, 0};
 };
 
 // What a ray hit: object index, primitive (triangle) index, t and the

@@ -1,8 +1,12 @@
 #include "pov_explain.h"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <iterator>
 #include <memory>
+#include <optional>
 
 #include "camera.h"
 #include "pov_mesh.h"
@@ -75,6 +79,16 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
   quiet.progress = false;
   RenderOptions pov_hit = quiet;
   pov_hit.pov_mesh_hit = true;
+  RenderOptions pov_isect = pov_hit;
+  pov_isect.pov_mesh_intersect = true;
+  RenderOptions pov_uv = pov_isect;
+  pov_uv.pov_mesh_uv = true;
+  RenderOptions pov_f32 = pov_uv;
+  pov_f32.float32_colour = true;
+  RenderOptions f32_only = quiet;
+  f32_only.float32_colour = true;
+  RenderOptions no_self_hit = quiet;
+  no_self_hit.skip_rounding_self_hits = true;
   struct Model {
     const char* cause;
     Scene scene;
@@ -92,9 +106,54 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
        "through its float32 Perp vector (shape/mesh.cpp); done so (with float32 mesh data and equal normals "
        "flat), our pixel equals POV-Ray's",
        as_pov_stores_it(scene, true, true), pov_hit},
+      {"mesh2 intersection: POV-Ray decides whether a ray meets a mesh2 triangle by projecting the point on its "
+       "float32 plane along the dominant axis of the normal and testing the three edges in 2D on the float32 "
+       "vertices (intersect_mesh_triangle), and its bounding-box tree search stops at the box entered after the "
+       "nearest hit, even a hit the caller then refuses as too close (a neighbouring triangle at t < 1e-3 hides the "
+       "rest of the mesh from a shadow ray) (shape/mesh.cpp); deciding every camera, reflected and shadow ray's "
+       "mesh hits so (with its hit point, float32 data and equal normals flat), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_isect},
+      {"mesh2 UV: POV-Ray computes a mesh2 hit's texture coordinates by its own projection onto the float32 "
+       "triangle sides (Mesh::UVCoord of shape/mesh.cpp), not with the smooth normal's weights; done so at its hit "
+       "point (with its inside test, float32 data and equal normals flat), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_uv},
+      {"float32 shading: POV-Ray keeps colours in float32 (RGBColour): the pigment, finish colours, light colours "
+       "and every product and sum of the shading rounded to float32 (trace.cpp); shaded so (with all the mesh2 "
+       "rules above), our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_f32},
+      {"float32 shading: POV-Ray keeps colours in float32 (RGBColour): the pigment, finish colours, light colours "
+       "and every product and sum of the shading rounded to float32 (trace.cpp); shaded so, our pixel equals "
+       "POV-Ray's",
+       scene, f32_only},
+      {"rounding self-hit: our reflected ray meets the primitive it leaves again, nearer than the rounding of its "
+       "origin allows (at a grazing angle far away the hit point's last bits put it on one side of the surface or "
+       "the other, and POV-Ray computes them differently); without that self-hit our pixel equals POV-Ray's",
+       scene, no_self_hit},
   };
   std::vector<std::unique_ptr<Tracer>> model_tracers;
   for (const auto& m : models) model_tracers.push_back(std::make_unique<Tracer>(m.scene, m.options));
+  constexpr std::size_t kAllMeshRules = 5;  // the float32 shading model with every mesh2 rule
+  const Model cache_models[] = {
+      {"shadow cache: POV-Ray first re-tests the object that last blocked the light (one cache for camera-ray hits, "
+       "one for deeper ones), accepting t >= 1e-4 where the ordinary test wants t > 1e-3 (trace.cpp, "
+       "TracePointLightShadowRay); the image rendered so in POV's order, our pixel equals POV-Ray's",
+       scene, quiet},
+      {"shadow cache: POV-Ray first re-tests the object that last blocked the light, accepting t >= 1e-4 where the "
+       "ordinary test wants t > 1e-3 (trace.cpp); the image rendered so in POV's order, with every mesh2 rule and "
+       "float32 colours, our pixel equals POV-Ray's",
+       models[kAllMeshRules].scene, models[kAllMeshRules].options},
+  };
+  std::optional<Image> cache_images[std::size(cache_models)];
+  std::unique_ptr<Tracer> uv_tracers[4];
+  {
+    constexpr double kUv = 1.0 / (1 << 22);
+    const std::array<double, 2> offsets[4] = {{kUv, 0}, {-kUv, 0}, {0, kUv}, {0, -kUv}};
+    for (int k = 0; k < 4; ++k) {
+      RenderOptions o = models[kAllMeshRules].options;
+      o.uv_offset = offsets[k];
+      uv_tracers[k] = std::make_unique<Tracer>(models[kAllMeshRules].scene, o);
+    }
+  }
   const Tracer tracer(scene, quiet);
   const Camera camera(scene.camera, scene.width, scene.height);
   const unsigned m = c.bits == 16 ? 65535u : 255u;
@@ -106,6 +165,34 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
       bool same = true;
       for (int ch = 0; ch < 3; ++ch) same &= quantize(rf[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
       if (same) e.cause = models[mi].cause;
+    }
+    // Texture lookups this close to a texel boundary (or this sensitive)
+    // are decided below the precision of POV's float32 mesh data: with every
+    // mesh2 rule, the lookup moved by 2^-22 in u or v (4 float32 ulps of a
+    // coordinate near 1) gives POV's pixel.
+    for (std::size_t k = 0; k < std::size(uv_tracers) && e.cause.empty(); ++k) {
+      const Color rc = uv_tracers[k]->pixel(d.x, d.y);
+      const float rf[3] = {float(rc.x), float(rc.y), float(rc.z)};
+      bool same = true;
+      for (int ch = 0; ch < 3; ++ch) same &= quantize(rf[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
+      if (same)
+        e.cause =
+            "float32 UV precision: the pixel's texture lookup is decided below the precision of POV-Ray's float32 "
+            "mesh data: with every mesh2 rule and the lookup moved by 2^-22 in u or v (4 float32 ulps near 1), our "
+            "pixel equals POV-Ray's";
+    }
+    // POV's shadow cache: the whole image rendered in POV's order with it
+    // (its state runs from pixel to pixel), alone and with every rule above.
+    for (std::size_t ci = 0; ci < std::size(cache_models) && e.cause.empty(); ++ci) {
+      if (!cache_images[ci]) {
+        RenderOptions o = cache_models[ci].options;
+        o.pov_shadow_cache = true;
+        cache_images[ci] = Tracer(cache_models[ci].scene, o).render();
+      }
+      bool same = true;
+      for (int ch = 0; ch < 3; ++ch)
+        same &= quantize(cache_images[ci]->at(d.x, d.y)[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
+      if (same) e.cause = cache_models[ci].cause;
     }
     if (e.cause.empty()) {
       // Our value within a few float32 ulps of a rounding boundary (k + 0.5) / max.

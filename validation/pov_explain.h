@@ -9,13 +9,26 @@
 //    float32 plane, and the smooth normal is interpolated there through its
 //    float32 Perp vector (renderer/pov_mesh.h); rendered so, with the two
 //    models above.
+//  - mesh2 intersection: which triangle a ray meets decided by POV's own
+//    test (dominant-axis projection on float32 data, renderer/pov_mesh.h)
+//    and its bounding-box tree search, which stops at the nearest hit even
+//    when the caller then refuses it (render.cpp, pov_mesh_hits), for every
+//    ray, with the models above.
+//  - mesh2 UV: texture coordinates by POV's Mesh::UVCoord at its hit point.
+//  - float32 shading: every colour of the shading rounded to float32, as
+//    POV's RGBColour is float (with all the mesh2 rules, and alone).
+//  - rounding self-hit: a reflected ray meeting the primitive it leaves
+//    within the rounding of its origin (grazing, far out), skipped.
+//  - shadow cache: POV first re-tests the object that last blocked a light
+//    (one cache for camera-ray hits, one for deeper ones), accepting
+//    t >= 1e-4 there instead of t > 1e-3. The whole image is re-rendered
+//    with that cache in POV's pixel order (RenderOptions::pov_shadow_cache),
+//    plainly and with every rule above.
 //  - float32 colour: our value within 4 float32 ulps of a rounding boundary.
-//  - shadow cache: POV first re-tests the object that blocked the previous
-//    shadow ray, accepting t >= 1e-4 there instead of t > 1e-3. We cast the
-//    pixel's shadow rays with the window [1e-4, 1e-3]; a blocker there, with
-//    POV's pixel darker than ours, is that quirk.
-// Camera rays only: a difference reached through a reflection is reported
-// as unexplained.
+//  - shadow cache, cheap test: a blocker of the camera hit's shadow ray in
+//    [1e-4, 1e-3] with POV's pixel darker than ours.
+// Every model re-renders the whole pixel (reflections included); only the
+// last, cheap shadow-cache test looks at the camera ray's hit alone.
 #pragma once
 #include <string>
 #include <vector>

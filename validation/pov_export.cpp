@@ -97,6 +97,12 @@ std::string idx3(int a, int b, int c) {
 // the set's normals and, for triangles without normal indices, the
 // area-weighted vertex normals.
 void write_mesh2(std::ostringstream& out, const TriangleSet& set, ImageNames& names) {
+  if (set.triangles.empty()) {
+    // POV-Ray refuses a mesh2 without faces ("Cannot parse input"); our
+    // tracer sees nothing there either (an OBJ of points or lines).
+    out << "// mesh " << comment_text(std::filesystem::path(set.name).filename().string()) << ": no triangles\n";
+    return;
+  }
   out << "// mesh " << comment_text(std::filesystem::path(set.name).filename().string()) << ", "
       << set.triangles.size() << " triangles\nmesh2 {\n  vertex_vectors { " << set.positions.size();
   for (const auto& p : set.positions) out << ",\n    " << vec(p);

@@ -163,5 +163,28 @@ TEST(PovExport, HostileTextureNameCannotInjectSdl) {
   fs::remove_all(dir);
 }
 
+// An OBJ of points or lines gives a mesh without triangles: POV-Ray refuses
+// an empty mesh2, so it is left out, and POV renders the background as we do
+// (found by the corpus sweep on assimp's point_cloud.obj).
+TEST(PovExport, MeshWithoutTrianglesIsLeftOut) {
+  Scene s;
+  s.width = 8;
+  s.height = 6;
+  s.background = {0.2, 0.4, 0.6};
+  auto set = std::make_shared<TriangleSet>();
+  set->name = "points.obj";
+  set->positions = {{0, 0, 0}, {1, 0, 0}};
+  set->materials.push_back(Material{});
+  Object o;
+  o.kind = Object::Kind::mesh;
+  o.mesh = set;
+  s.objects.push_back(o);
+  const PovExport ex = export_pov(s);
+  EXPECT_EQ(ex.sdl.find("mesh2"), std::string::npos) << ex.sdl;
+  if (!povray_available()) GTEST_SKIP() << "POV-Ray is not installed (Debian package povray)";
+  const PovRun run = render_with_povray(s);
+  EXPECT_NEAR(run.image.at(3, 2)[1], 0.4, 0.5 / 255);
+}
+
 }  // namespace
 }  // namespace ra
