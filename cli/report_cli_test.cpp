@@ -1,0 +1,214 @@
+// `rayaudit report` and `rayaudit crack-maps` (issue 14): bad input is one line
+// and exit 2 with nothing written; a report from a real small run opens in
+// headless Chromium with every image and chart drawn and no console error.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
+#include "image.h"
+#include "run_rayaudit.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using ra::test::run_rayaudit;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("rayaudit-report-test-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+// A genuine audit output, small (two methods, two families).
+fs::path small_audit(const fs::path& dir) {
+  const fs::path a = dir / "audit.json";
+  const auto r = run_rayaudit("audit --methods moller,watertight --families edge,closed-mesh --rays 600 --json " +
+                              a.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  return a;
+}
+
+TEST(ReportCli, MissingAuditNamesTheFileExit2NothingWritten) {
+  const fs::path d = fresh_dir("missing");
+  const auto r = run_rayaudit("report --audit " + (d / "nope.json").string() + " -o " + (d / "rep").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find((d / "nope.json").string() + ": no such file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "rep"));
+  fs::remove_all(d);
+}
+
+TEST(ReportCli, MalformedJsonNamesFileAndLineExit2NothingWritten) {
+  const fs::path d = fresh_dir("malformed");
+  const fs::path a = small_audit(d);
+  const fs::path bad = d / "bench.json";
+  std::ofstream(bad) << "{\n \"context\": {},\n \"benchmarks\": [\n  {\"name\": \"kernel/x\",}\n ]\n}\n";
+  const auto r = run_rayaudit("report --audit " + a.string() + " --bench " + bad.string() + " -o " + (d / "rep").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(bad.string() + ":4: malformed JSON"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "rep"));
+  fs::remove_all(d);
+}
+
+TEST(ReportCli, WrongShapeNamesTheKeyExit2) {
+  const fs::path d = fresh_dir("shape");
+  const fs::path a = d / "audit.json";
+  std::ofstream(a) << R"({"seed": 1, "rays_per_family": 10, "subjects": [{"name": "m/float"}], "cells": []})";
+  fs::create_directories(d / "rep");  // an existing output directory stays untouched
+  const auto r = run_rayaudit("report --audit " + a.string() + " -o " + (d / "rep").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, a.string() + ": subjects[0]: missing 'method'\n");
+  EXPECT_TRUE(fs::is_empty(d / "rep"));
+  fs::remove_all(d);
+}
+
+TEST(CrackMapsCli, BadOffsetAndOpenMeshExit2NothingWritten) {
+  const fs::path d = fresh_dir("crackbad");
+  auto r = run_rayaudit("crack-maps -o " + (d / "cm").string() + " --offsets 1,abc --mesh " RAYAUDIT_SOURCE_DIR
+                        "/scenes/meshes/cube.obj");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "--offsets: 'abc' is not an offset between 0 and 1e30\n");
+  r = run_rayaudit("crack-maps -o " + (d / "cm").string() + " --mesh " RAYAUDIT_SOURCE_DIR "/scenes/meshes/quad.obj");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("quad.obj: not a closed outward mesh"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "cm"));
+  fs::remove_all(d);
+}
+
+// Near the origin the watertight method finds every crossing the oracle finds
+// on a closed mesh (no leak); each map's red pixels are exactly its leaks.
+TEST(CrackMapsCli, NoLeakNearTheOriginAndRedPixelsAreTheLeaks) {
+  const fs::path d = fresh_dir("crack");
+  const auto r = run_rayaudit("crack-maps -o " + (d / "cm").string() +
+                              " --size 48 --offsets 1,1e7 --methods moller,watertight --mesh " RAYAUDIT_SOURCE_DIR
+                              "/scenes/meshes/tetrahedron.obj");
+  ASSERT_EQ(r.code, 0) << r.all;
+  const auto j = nlohmann::json::parse(slurp(d / "cm" / "crack_maps.json"));
+  ASSERT_EQ(j["maps"].size(), 2u * 2u * 2u);  // sphere + tetrahedron, 2 offsets, 2 methods
+  for (const auto& m : j["maps"]) {
+    EXPECT_GT(m["surface_pixels"].get<long long>(), 48 * 48 / 20) << m;  // the mesh is in view
+    if (m["method"] == "watertight" && m["offset"] == 1) EXPECT_EQ(m["leaks"], 0) << m;
+    const ra::Image img = ra::read_image(d / "cm" / m["image"].get<std::string>());
+    ASSERT_EQ(img.width, 48);
+    long long red = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        const float* p = img.at(x, y);
+        red += p[0] > 0.5f && p[1] < 0.1f && p[2] < 0.1f;
+      }
+    EXPECT_EQ(red, m["leaks"].get<long long>()) << m;
+  }
+  fs::remove_all(d);
+}
+
+// Runs a command, returning its exit code and putting stdout + stderr in `out`.
+int sh(const std::string& cmd, std::string& out) {
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  out.clear();
+  char buf[4096];
+  std::size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 128;
+}
+
+std::string chromium(const fs::path& profile) {
+  return "/usr/bin/chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+         "--disable-background-networking --disable-component-update --disable-sync --user-data-dir=" +
+         profile.string();
+}
+
+// A report from a real small run: the audit, crack maps, a POV-Ray comparison
+// and a golden check, then opened in headless Chromium. The page checks
+// itself on load (every <img> decoded, every chart's SVG with a non-empty
+// box) and says so in #selfcheck; any console message fails the test. The
+// screenshot is left beside the page (build dir) to look at.
+TEST(ReportBrowser, RealSmallRunOpensInChromiumWithEverythingDrawn) {
+  if (!fs::exists("/usr/bin/chromium")) GTEST_FAIL() << "/usr/bin/chromium missing (ci/install-deps.sh installs it)";
+  const fs::path d = fs::path(RAYAUDIT_BUILD_DIR) / "report-browser-test";
+  fs::remove_all(d);
+  fs::create_directories(d / "pov");
+  const fs::path audit = d / "audit.json";
+  auto r = run_rayaudit("audit --rays 2000 --json " + audit.string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  r = run_rayaudit("crack-maps -o " + (d / "cm").string() +
+                   " --size 32 --offsets 1,1e5,1e7 --methods angles,moller,watertight --mesh " RAYAUDIT_SOURCE_DIR
+                   "/scenes/meshes/cube.obj");
+  ASSERT_EQ(r.code, 0) << r.all;
+  const std::string scene = RAYAUDIT_SOURCE_DIR "/scenes/doc000-pyramid.json";
+  r = run_rayaudit("compare " + scene + " --width 80 --height 60 --explain --json " + (d / "pov/pyramid.json").string() +
+                   " --diff " + (d / "pov/pyramid-diff.png").string() + " --ours " + (d / "pov/pyramid-ours.png").string() +
+                   " --pov " + (d / "pov/pyramid-pov.png").string());
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.all;  // a difference beyond tolerance is still a report
+  r = run_rayaudit("golden check doc000-pyramid --json " + (d / "golden.json").string() + " --diff-dir " +
+                   (d / "golden-diffs").string());
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.all;
+  std::ofstream(d / "stages.tsv") << "audit\t1\ncrack maps\t2\n";
+  r = run_rayaudit("report --audit " + audit.string() + " --compare " + (d / "pov").string() + " --crack-maps " +
+                   (d / "cm").string() + " --golden " + (d / "golden.json").string() + " --stages " +
+                   (d / "stages.tsv").string() + " -o " + (d / "report").string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  const fs::path page = d / "report" / "index.html";
+  ASSERT_TRUE(fs::exists(page));
+  EXPECT_LT(fs::file_size(page), 4u << 20);  // a few MB at most
+  const std::string html = slurp(page);
+  EXPECT_EQ(html.find("http://"), std::string::npos);  // nothing fetched: opens offline
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  EXPECT_NE(html.find("No benchmark given"), std::string::npos);  // said plainly, not hidden
+
+  const auto rep = nlohmann::json::parse(slurp(d / "report" / "report.json"));
+  for (const char* k : {"speed_accuracy", "stability", "crack_maps", "optimisations", "peers", "images", "machine"})
+    EXPECT_TRUE(rep.contains(k)) << k;
+  EXPECT_EQ(rep["crack_maps"].size(), 2u * 3u * 3u);
+  EXPECT_EQ(rep["images"].size(), 1u);
+  for (const auto& e : rep["speed_accuracy"])
+    for (const char* k : {"subject", "ns_per_test", "wrong_pct", "leaks_per_million"}) EXPECT_TRUE(e.contains(k)) << k;
+
+  // Expected on the page: each crack map and the three thumbnails of the scene.
+  const int images = 2 * 3 * 3 + 3;
+  std::string dom;
+  const fs::path profile = d / "chromium-profile";
+  int rc = sh(chromium(profile) + " --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom file://" +
+                  page.string(),
+              dom);
+  ASSERT_EQ(rc, 0) << dom;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(dom, m, std::regex(R"(<p id="selfcheck"[^>]*>)"))) << dom.substr(0, 2000);
+  const std::string tag = m.str();
+  EXPECT_NE(tag.find("data-result=\"ok\""), std::string::npos) << tag;
+  EXPECT_NE(tag.find("data-images=\"" + std::to_string(images) + "\""), std::string::npos) << tag;
+  std::smatch charts;
+  ASSERT_TRUE(std::regex_search(tag, charts, std::regex(R"(data-charts="(\d+)")")));
+  EXPECT_GE(std::stoi(charts[1]), 3);  // speed/accuracy, edge and closed-mesh stability, crack leaks at least
+  // Chromium logs every console message as ":CONSOLE(line)"; the page writes none.
+  std::smatch console;
+  EXPECT_FALSE(std::regex_search(dom, console, std::regex(R"([^\n]*CONSOLE[^\n]*)"))) << console.str();
+  EXPECT_EQ(dom.find("Uncaught"), std::string::npos);
+
+  const fs::path shot = d / "report" / "screenshot.png";
+  std::string log;
+  rc = sh("cd " + d.string() + " && " + chromium(profile) + " --hide-scrollbars --window-size=1280,2400 --screenshot=" +
+              shot.string() + " file://" + page.string(),
+          log);
+  ASSERT_EQ(rc, 0) << log;
+  ASSERT_TRUE(fs::exists(shot)) << log;
+  EXPECT_GT(fs::file_size(shot), 20000u);  // a page of charts, not a blank
+}
+
+}  // namespace
