@@ -31,6 +31,7 @@ plt.rcParams.update({
     "axes.grid": True,
     "grid.alpha": 0.3,
     "figure.dpi": 96,
+    "figure.constrained_layout.use": True,
 })
 
 THUMB = 160  # largest side of an image thumbnail, pixels
@@ -60,6 +61,13 @@ def data_uri(path, max_side=THUMB):
 
 def esc(s):
     return html.escape(str(s))
+
+
+def offset_label(v):
+    """1 -> '1', 1000 -> '1e3', 1e7 -> '1e7'."""
+    if v > 0 and v >= 1000 and 10 ** round(math.log10(v)) == v:
+        return f"1e{round(math.log10(v))}"
+    return f"{v:g}"
 
 
 def fnum(v, digits=3):
@@ -162,6 +170,7 @@ def speed_accuracy(audit, bench, methods):
             "groups": groups,
             "leaks_per_million": (1e6 * t.get("leaks", 0) / groups) if groups else None,
             "tests": t["tests"],
+            "worst": s.get("worst"),
         })
     return out
 
@@ -183,7 +192,8 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
         ax.scatter([x], [y], s=60, marker="o" if e["precision"] == "float" else "s",
                    facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=3)
         ax.annotate(("doc: " if doc else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d"),
-                    (x, y), textcoords="offset points", xytext=(5, 4), fontsize=7.5)
+                    (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6.5,
+                    color=c, alpha=0.9)
     front = pareto(pts)
     if len(front) > 1:
         ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, alpha=0.6,
@@ -192,12 +202,13 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
         ax.scatter([pts[front[0]][0]], [pts[front[0]][1]], s=220, facecolors="none", edgecolors="k",
                    label="Pareto front")
     ax.set_yscale("log")
-    ax.axhline(ZERO_FLOOR, color="g", lw=0.8, alpha=0.6)
-    ax.text(ax.get_xlim()[0], ZERO_FLOOR, " 0 (none found)", color="g", fontsize=7, va="bottom")
+    if any(e[yfield] == 0 for e in entries):  # zeros sit on a floor line, labelled
+        ax.axhline(ZERO_FLOOR, color="g", lw=0.8, alpha=0.6)
+        ax.text(ax.get_xlim()[0], ZERO_FLOOR, " 0 (none found)", color="g", fontsize=7, va="bottom")
     ax.set_xlabel("ns per ray/triangle test (kernel bench, 50% hits; left is faster)")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
-    ax.legend(loc="upper right", fontsize=7)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=7, frameon=False)
 
 
 def chart_speed_accuracy(entries, methods, have_bench):
@@ -341,7 +352,8 @@ def chart_stability(stab, methods):
             for ax in axes[i]:
                 ax.set_ylim(0, top)
         axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1))
-        caption = (f"{family}: how each method fares as the {d['param']} grows; float left, double right, "
+        how = f"as the {d['param']} grows" if numeric else f"for each {d['param']}"
+        caption = (f"{family}: how each method fares {how}; float left, double right, "
                    "dashed lines are the seed documents' methods. Flat at 0 is right; a rising line is where "
                    "that method breaks.")
         charts.append((family, svg_of(fig), caption))
@@ -372,6 +384,7 @@ def chart_crack_leaks(maps, methods):
                     label=methods.label(method))
         ax.set_xscale("log")
         ax.set_yscale("symlog", linthresh=1)
+        ax.set_ylim(bottom=0)
         ax.set_xlabel("offset of the mesh from the origin (log)")
         ax.set_ylabel("leaking pixels")
         ax.set_title(f"{mesh}: leaking pixels in float")
@@ -631,9 +644,9 @@ def page(rep, charts, methods, uris):
         facts.append(f"Fastest triangle test: <b>{esc(f['subject'])}</b> at {fnum(f['ns_per_test'])} ns "
                      f"({fnum(f['wrong_pct'])}% wrong)")
     if sa:
-        right = min(sa, key=lambda e: (e["wrong_pct"], e["leaks_per_million"] or 0, e["ns_per_test"] or 0))
-        facts.append(f"Fewest wrong answers: <b>{esc(right['subject'])}</b> ({fnum(right['wrong_pct'])}% wrong, "
-                     f"{fnum(right['leaks_per_million'])} leaks per million)")
+        right = min(sa, key=lambda e: (e["leaks"] > 0, e["wrong_pct"], e["ns_per_test"] or 0))
+        facts.append(f"Most right: <b>{esc(right['subject'])}</b> ({fnum(right['wrong_pct'])}% wrong, "
+                     f"{right['leaks']} leaks)")
         leakfree = [e["subject"] for e in sa if e["leaks"] == 0]
         facts.append("Leak-free (no ray through a closed group): " +
                      (", ".join(f"<b>{esc(s)}</b>" for s in leakfree) if leakfree else "<b>none</b>"))
@@ -668,12 +681,16 @@ def page(rep, charts, methods, uris):
     for svg, cap in charts["speed_accuracy"]:
         h.append(chart_html(svg, cap))
     h.append('<table><tr><th class="l">method/precision</th><th>ns per test</th><th>wrong %</th><th>leaks</th>'
-             '<th>leaks per million</th><th>tests</th><th class="l">source</th></tr>')
+             '<th>leaks per million</th><th>tests</th><th class="l">breaks worst at (family@sweep)</th>'
+             '<th class="l">source</th></tr>')
     for e in rep["speed_accuracy"]:
         src = methods.by_name.get(e["method"], {}).get("source", "")
+        w = e.get("worst")
+        worst = f"{w['family']}@{w['sweep']} ({100 * w['badness']:.3g}% bad)" if w else "nowhere"
         h.append(f'<tr><td class="l">{esc(methods.label(e["method"]))}/{esc(e["precision"])}</td>'
                  f"<td>{fnum(e['ns_per_test'])}</td><td>{fnum(e['wrong_pct'])}</td><td>{e['leaks']}</td>"
-                 f"<td>{fnum(e['leaks_per_million'])}</td><td>{e['tests']}</td><td class=\"l\">{esc(src)}</td></tr>")
+                 f"<td>{fnum(e['leaks_per_million'])}</td><td>{e['tests']}</td>"
+                 f"<td class=\"l\">{esc(worst)}</td><td class=\"l\">{esc(src)}</td></tr>")
     h.append("</table>")
 
     # ---- 2
@@ -689,15 +706,15 @@ def page(rep, charts, methods, uris):
         h.append('<p class="notice">No crack maps given (<code>rayaudit crack-maps -o DIR</code>, then '
                  "<code>--crack-maps DIR</code>).</p>")
     else:
-        h.append(chart_html(charts["crack_leaks"], "Leaking pixels of each method in float as the mesh moves away "
-                            "from the origin: the watertight method should stay at 0."))
+        h.append(chart_html(charts["crack_leaks"], "Leaking pixels (rays through the closed surface) of each method "
+                            "in float as the mesh moves away from the origin, where every ray starts: 0 is right."))
         cm = rep["crack_maps"]
         for mesh in dict.fromkeys(c["mesh"] for c in cm):
             info = next((x for x in rep["crack_meshes"] if x["name"] == mesh), {})
             h.append(f"<h3>{esc(mesh)}: {esc(info.get('source', ''))}, {info.get('triangles', '?')} triangles</h3>")
             offsets = sorted(dict.fromkeys(c["offset"] for c in cm if c["mesh"] == mesh))
             h.append('<table class="grid"><tr><th class="l">method (float)</th>' +
-                     "".join(f"<th>offset {fnum(o)}</th>" for o in offsets) + "</tr>")
+                     "".join(f"<th>offset {offset_label(o)}</th>" for o in offsets) + "</tr>")
             for method in dict.fromkeys(c["method"] for c in cm if c["mesh"] == mesh):
                 h.append(f'<tr><td class="l">{esc(methods.label(method))}</td>')
                 for o in offsets:
