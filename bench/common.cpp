@@ -26,7 +26,7 @@ std::vector<int> thread_counts() {
 }
 
 int repetitions() { return config().quick ? 3 : 5; }
-double min_time() { return config().quick ? 0.01 : 0.05; }
+double min_time() { return config().quick ? 0.005 : 0.03; }
 
 double thread_cpu_seconds() {
   timespec t{};

@@ -176,7 +176,8 @@ void register_pov() {
   for (const char* name : {"bunny", "dragon"}) {
     const Rung* r = find_rung(name);
     if (config().quick && !r->quick) continue;
-    for (int t : thread_counts())
+    // --quick: one thread only (POV-Ray takes seconds per image).
+    for (int t : config().quick ? std::vector<int>{1} : thread_counts())
       add("peer/pov/" + r->name + "/threads=" + std::to_string(t), {rung_obj(*r), rung_scene_file(*r)},
           [=](benchmark::State& s) { bm_pov(s, r, t); })
           ->Unit(benchmark::kMillisecond);

@@ -4,7 +4,9 @@
 # rendered (OUT/renders), every method audited against exact arithmetic
 # (OUT/audit), every scene POV-Ray can express compared with POV-Ray 3.7
 # (OUT/pov) and checked against its golden image (OUT/golden-diffs on a
-# difference). Idempotent; exits 1 if a comparison or golden check fails,
+# difference), and the quick benchmark written to OUT/bench/bench.json
+# (Google Benchmark's JSON; the console table in OUT/bench/table.txt).
+# Idempotent; exits 1 if a comparison, golden check or benchmark row fails,
 # after running them all.
 #
 # Scenes may name files in the cache (${cache}/... in a mesh path, see
@@ -50,6 +52,15 @@ for scene in scenes/*.json scenes/corpus/*.json; do compare "$scene"; done
 
 step "checking the golden images (diffs into $OUT/golden-diffs)"
 "$RAYAUDIT" golden check --skip-unavailable --diff-dir "$OUT/golden-diffs" || { rc=$?; [ "$rc" = 77 ] || failed=1; }
+
+step "benchmarks, --quick (about 2 minutes on 2 idle cores), into $OUT/bench"
+mkdir -p "$OUT/bench"
+echo "rayaudit bench --quick --json $OUT/bench/bench.json"
+rc=0
+"$RAYAUDIT" bench --quick --json "$OUT/bench/bench.json" > "$OUT/bench/table.txt" || rc=$?
+# The peers' hit-count agreement and where the JSON went.
+grep -E '^(embree|cgal) .* differ$|^wrote ' "$OUT/bench/table.txt" | sed 's/^/  /' || true
+if [ "$rc" != 0 ]; then echo "  FAILED (exit $rc)"; failed=1; fi
 
 step "done: outputs are in $OUT"
 exit $failed
