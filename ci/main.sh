@@ -4,11 +4,13 @@
 # rendered (OUT/renders), every method audited against exact arithmetic
 # (OUT/audit), every scene POV-Ray can express compared with POV-Ray 3.7
 # (OUT/pov) and checked against its golden image (OUT/golden-diffs on a
-# difference), crack maps drawn (OUT/crack-maps), the quick benchmark run
-# (OUT/bench) and everything gathered into one page, OUT/report/index.html
-# with OUT/report/report.json (rayaudit report). Each stage is announced and
-# timed (OUT/stages.tsv, shown in the report's header). Idempotent; exits 1
-# if a comparison or golden check fails, after running them all.
+# difference), crack maps drawn (OUT/crack-maps), the quick benchmark
+# written to OUT/bench/bench.json (Google Benchmark's JSON; the console
+# table in OUT/bench/table.txt) and everything gathered into one page,
+# OUT/report/index.html with OUT/report/report.json (rayaudit report). Each
+# stage is announced and timed (OUT/stages.tsv, shown in the report's
+# header). Idempotent; exits 1 if a comparison, golden check or benchmark
+# row fails, after running them all.
 #
 # Scenes may name files in the cache (${cache}/... in a mesh path, see
 # scenes/README.md): ci/fetch-corpus.sh fills it first (the mesh ladder and
@@ -69,13 +71,23 @@ stage "golden" "checking the golden images (diffs into $OUT/golden-diffs)"
 stage "crack maps" "crack maps: the audit's sphere and the ladder's elephant at offsets 1..1e7, each triangle method in float, into $OUT/crack-maps"
 "$RAYAUDIT" crack-maps -o "$OUT/crack-maps" | tail -n 1
 
-bench_arg=()
-if "$RAYAUDIT" bench --help >/dev/null 2>&1; then
-  stage "bench" "the quick benchmark into $OUT/bench/bench.json (rayaudit bench --quick)"
-  mkdir -p "$OUT/bench"
-  "$RAYAUDIT" bench --quick --json "$OUT/bench/bench.json"
-  bench_arg=(--bench "$OUT/bench/bench.json")
+stage "bench" "benchmarks, --quick (about 2 minutes on 2 idle cores), into $OUT/bench"
+mkdir -p "$OUT/bench"
+rm -f "$OUT/bench/bench.json"  # a stale one must not stand in for a failed run
+echo "rayaudit bench --quick --json $OUT/bench/bench.json"
+rc=0
+# On a terminal, a running count of finished rows (the table goes to table.txt).
+if [ -t 1 ]; then
+  "$RAYAUDIT" bench --quick --json "$OUT/bench/bench.json" | tee "$OUT/bench/table.txt" |
+    awk '/ns|ms|us/ { n++; printf "\r  %d rows done", n } END { printf "\r%30s\r", "" }' || rc=$?
+else
+  "$RAYAUDIT" bench --quick --json "$OUT/bench/bench.json" > "$OUT/bench/table.txt" || rc=$?
 fi
+# The peers' hit-count agreement and where the JSON went.
+grep -E '^(embree|cgal) .* differ$|^wrote ' "$OUT/bench/table.txt" | sed 's/^/  /' || true
+bench_arg=()
+if [ "$rc" != 0 ]; then echo "  FAILED (exit $rc)"; failed=1; fi
+if [ -f "$OUT/bench/bench.json" ]; then bench_arg=(--bench "$OUT/bench/bench.json"); fi
 
 stage "report" "the report: $OUT/report/index.html and report.json"
 "$RAYAUDIT" report --audit "$OUT/audit/audit.json" "${bench_arg[@]}" --compare "$OUT/pov" \
