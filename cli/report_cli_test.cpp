@@ -66,6 +66,35 @@ TEST(ReportCli, MalformedJsonNamesFileAndLineExit2NothingWritten) {
   fs::remove_all(d);
 }
 
+// Google Benchmark writes NaN for a counter's cv over constant values (as in
+// ci/main.sh's quick run); the report reads that file as it is.
+TEST(ReportCli, AcceptsGoogleBenchmarksNaN) {
+  const fs::path d = fresh_dir("nan");
+  const fs::path a = small_audit(d);
+  const fs::path b = d / "bench.json";
+  std::ofstream(b) << R"({
+  "context": {"date": "2026-11-24T02:47:36+00:00", "num_cpus": 2, "library_build_type": "debug"},
+  "benchmarks": [
+    {"name": "kernel/moller/float/nocull/hit=50/back=0_median", "run_name": "kernel/moller/float/nocull/hit=50/back=0",
+     "run_type": "aggregate", "aggregate_name": "median", "hit_rate": 5.0e-01, "ns_per_test": 3.5e+00},
+    {"name": "kernel/moller/float/nocull/hit=50/back=0_cv", "run_name": "kernel/moller/float/nocull/hit=50/back=0",
+     "run_type": "aggregate", "aggregate_name": "cv", "expected_hit_rate": NaN, "hit_rate": NaN,
+     "ns_per_test": 7.7e-03}
+  ]
+})";
+  const auto r = run_rayaudit("report --audit " + a.string() + " --bench " + b.string() + " -o " + (d / "rep").string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  const auto rep = nlohmann::json::parse(slurp(d / "rep" / "report.json"));
+  bool seen = false;
+  for (const auto& e : rep["speed_accuracy"])
+    if (e["subject"] == "moller/float") {
+      seen = true;
+      EXPECT_EQ(e["ns_per_test"].get<double>(), 3.5);  // the median row, not the cv
+    }
+  EXPECT_TRUE(seen);
+  fs::remove_all(d);
+}
+
 TEST(ReportCli, WrongShapeNamesTheKeyExit2) {
   const fs::path d = fresh_dir("shape");
   const fs::path a = d / "audit.json";

@@ -21,6 +21,7 @@ import matplotlib
 
 matplotlib.use("svg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
@@ -202,10 +203,14 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
         ax.scatter([pts[front[0]][0]], [pts[front[0]][1]], s=220, facecolors="none", edgecolors="k",
                    label="Pareto front")
     ax.set_yscale("log")
+    ax.set_xscale("log")
+    ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.tick_params(axis="x", which="minor", labelsize=6.5)
     if any(e[yfield] == 0 for e in entries):  # zeros sit on a floor line, labelled
         ax.axhline(ZERO_FLOOR, color="g", lw=0.8, alpha=0.6)
         ax.text(ax.get_xlim()[0], ZERO_FLOOR, " 0 (none found)", color="g", fontsize=7, va="bottom")
-    ax.set_xlabel("ns per ray/triangle test (kernel bench, 50% hits; left is faster)")
+    ax.set_xlabel("ns per ray/triangle test (log; kernel bench, 50% hits; left is faster)")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=7, frameon=False)
@@ -440,25 +445,34 @@ def chart_optimisations(opt):
     charts = []
     sp = opt["speedups"]
     if sp:
-        whats = list(dict.fromkeys(s["what"] for s in sp))
         raykinds = list(dict.fromkeys(s["rays"] for s in sp))
-        fig, axes = plt.subplots(1, len(raykinds), figsize=(6 * len(raykinds), 3.6), squeeze=False)
-        for ax, rk in zip(axes[0], raykinds):
-            meshes = sorted(dict.fromkeys(s["mesh"] for s in sp if s["rays"] == rk),
-                            key=lambda m: next(s["triangles"] or 0 for s in sp if s["mesh"] == m))
-            w = 0.8 / max(1, len(whats))
-            for k, what in enumerate(whats):
-                vals = [next((s["speedup"] for s in sp if s["mesh"] == m and s["what"] == what and s["rays"] == rk),
-                             np.nan) for m in meshes]
-                ax.bar(np.arange(len(meshes)) + k * w, vals, w, label=what)
-            ax.axhline(1, color="k", lw=0.8)
-            ax.set_yscale("log")
-            ax.set_xticks(np.arange(len(meshes)) + w * (len(whats) - 1) / 2, meshes, rotation=20, fontsize=7)
-            ax.set_ylabel("speed-up (x, log; above 1 is faster)")
-            ax.set_title(f"{rk} rays, {opt['threads']} thread(s)")
-        axes[0][-1].legend(fontsize=7)
+        groups = [("accelerator over none", [w for w in dict.fromkeys(s["what"] for s in sp) if "over none" in w]),
+                  ("backface culling", [w for w in dict.fromkeys(s["what"] for s in sp) if w.startswith("culling")])]
+        groups = [g for g in groups if g[1]]
+        fig, axes = plt.subplots(len(groups), len(raykinds), figsize=(6 * len(raykinds), 3.2 * len(groups)),
+                                 squeeze=False)
+        for gi, (gname, whats) in enumerate(groups):
+            for ax, rk in zip(axes[gi], raykinds):
+                meshes = sorted(dict.fromkeys(s["mesh"] for s in sp if s["rays"] == rk and s["what"] in whats),
+                                key=lambda m: next(s["triangles"] or 0 for s in sp if s["mesh"] == m))
+                w = 0.8 / max(1, len(whats))
+                for k, what in enumerate(whats):
+                    vals = [next((s["speedup"] for s in sp if s["mesh"] == m and s["what"] == what and s["rays"] == rk),
+                                 np.nan) for m in meshes]
+                    bars = ax.bar(np.arange(len(meshes)) + k * w, vals, w, label=what)
+                    ax.bar_label(bars, labels=[f"{v:.2g}x" if v == v else "" for v in vals], fontsize=6.5)
+                ax.axhline(1, color="k", lw=0.8)
+                ax.set_yscale("log")
+                times = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:.3g}x")
+                ax.yaxis.set_major_formatter(times)
+                ax.yaxis.set_minor_formatter(times)
+                ax.tick_params(axis="y", which="minor", labelsize=6.5)
+                ax.set_xticks(np.arange(len(meshes)) + w * (len(whats) - 1) / 2, meshes, rotation=15, fontsize=7)
+                ax.set_ylabel("speed-up (x, log)")
+                ax.set_title(f"{gname}: {rk} rays, {opt['threads']} thread(s)")
+                ax.legend(fontsize=7)
         charts.append((svg_of(fig), "Each bar is rays per second with the optimisation divided by without it, "
-                       "per rung of the mesh ladder: above the line it pays, below it costs."))
+                       "per rung of the mesh ladder (smallest left): above the line it pays, below it costs."))
     if opt["scaling"]:
         fig, ax = plt.subplots(figsize=(6.5, 4))
         for s in opt["scaling"]:
@@ -498,6 +512,12 @@ def chart_peers(ps):
     ax.set_yticks(list(ys), [re.sub(r"^peer/", "", p["name"]) for p in ps], fontsize=6.5)
     ax.axvline(1, color="k", lw=0.8)
     ax.set_xscale("log")
+    ticks = [t for t in (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100)
+             if min(p["ratio"] for p in ps) / 2 <= t <= max(p["ratio"] for p in ps) * 2]
+    ax.set_xticks(ticks, [f"{t:g}x" for t in ticks])
+    ax.minorticks_off()
+    for y, p in zip(ys, ps):
+        ax.text(p["ratio"], y, f" {p['ratio']:.2g}x", va="center", fontsize=6.5)
     ax.invert_yaxis()
     ax.set_xlabel("rayaudit's rate / the peer's (log): right of 1, rayaudit is faster; left, the peer")
     ax.set_title("rayaudit against its peers, same rays, same run")
@@ -666,7 +686,9 @@ def page(rep, charts, methods, uris):
             ("Libraries", ", ".join(f"{k} {v}" for k, v in m["versions"].items())),
             ("Audit", f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method x precision")]
     if m["bench_context"]:
-        rows.append(("Benchmark", ", ".join(f"{k} {v}" for k, v in m["bench_context"].items())))
+        names = {"host_name": "host", "num_cpus": "CPUs", "mhz_per_cpu": "MHz",
+                 "library_build_type": "Google Benchmark library built as", "date": "run at"}
+        rows.append(("Benchmark", ", ".join(f"{names.get(k, k)} {v}" for k, v in m["bench_context"].items())))
     if m["stages"]:
         rows.append(("Stages", ", ".join(f"{esc(s['stage'])} {s['seconds']:.0f} s" for s in m["stages"])))
     for k, v in rows:
@@ -789,6 +811,17 @@ def page(rep, charts, methods, uris):
     return "\n".join(h)
 
 
+def finite(v):
+    """JSON has no NaN or infinity (Google Benchmark writes them): null instead."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, dict):
+        return {k: finite(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [finite(x) for x in v]
+    return v
+
+
 def main():
     with open(sys.argv[1]) as f:
         ctx = json.load(f)
@@ -846,7 +879,7 @@ def main():
     with open(os.path.join(out, "index.html"), "w") as f:
         f.write(text)
     with open(os.path.join(out, "report.json"), "w") as f:
-        json.dump(rep, f, indent=1, allow_nan=False, default=str)
+        json.dump(finite(rep), f, indent=1, allow_nan=False, default=str)
         f.write("\n")
 
 
