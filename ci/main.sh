@@ -94,5 +94,5 @@ stage "report" "the report: $OUT/report/index.html and report.json"
   --crack-maps "$OUT/crack-maps" --golden "$OUT/golden/golden.json" --stages "$STAGES" -o "$OUT/report"
 printf '%s\t%s\n' "$stage_name" "$((SECONDS - stage_start))" >>"$STAGES"
 
-step "done in ${SECONDS} s (stages: $(tr '\t\n' ' ,' <"$STAGES")): open $OUT/report/index.html"
+step "done in ${SECONDS} s ($(awk -F'\t' '{ printf "%s%s %s s", (NR > 1 ? ", " : ""), $1, $2 }' "$STAGES")): open $OUT/report/index.html"
 exit $failed
