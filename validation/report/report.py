@@ -23,7 +23,7 @@ matplotlib.use("svg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
-from PIL import Image  # noqa: E402
+from PIL import Image, ImageDraw  # noqa: E402
 
 plt.rcParams.update({
     "svg.fonttype": "none",  # text stays text: smaller and searchable
@@ -50,11 +50,20 @@ def svg_of(fig):
     return text[text.index("<svg"):]
 
 
-def data_uri(path, max_side=THUMB):
+def data_uri(path, max_side=THUMB, marks=()):
+    """A PNG thumbnail as a data: URI; `marks` (x, y) pixels of the original
+    are ringed, so a single differing pixel still shows after shrinking."""
     with Image.open(path) as im:
         im = im.convert("RGB")
+        w0 = im.size[0]
         if max(im.size) > max_side:
             im.thumbnail((max_side, max_side), Image.NEAREST)
+        if marks:
+            draw = ImageDraw.Draw(im)
+            k = im.size[0] / w0
+            for x, y in marks:
+                cx, cy = (x + 0.5) * k, (y + 0.5) * k
+                draw.ellipse((cx - 5, cy - 5, cx + 5, cy + 5), outline=(255, 220, 0), width=2)
         buf = io.BytesIO()
         im.save(buf, format="PNG", optimize=True)
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
@@ -779,7 +788,8 @@ def page(rep, charts, methods, uris):
         h.append('<p class="notice">No comparisons given (<code>--compare DIR</code>).</p>')
     else:
         h.append('<p class="cap">Each scene as we render it, as POV-Ray 3.7 renders it, and their difference '
-                 "(false colour; black is equal). Every differing pixel is listed with the cause --explain found.</p>")
+                 "(false colour; black is equal; each differing pixel ringed in yellow). Every differing pixel is "
+                 "listed with the cause --explain found.</p>")
         h.append('<table class="thumbs"><tr><th class="l">scene</th><th>ours</th><th>POV-Ray</th><th>difference</th>'
                  '<th class="l">verdict</th></tr>')
         for im in rep["images"]:
@@ -872,8 +882,9 @@ def main():
     for c in rep["crack_maps"]:
         uris[c["image"]] = data_uri(c["image"])
     for im in rep["images"]:
-        for p in im["files"].values():
-            uris[p] = data_uri(p)
+        for kind, p in im["files"].items():
+            marks = [(d["x"], d["y"]) for d in im["differences"]] if kind == "diff" else ()
+            uris[p] = data_uri(p, marks=marks[:50])
     text = page(rep, charts, methods, uris)
     out = ctx["out_dir"]
     with open(os.path.join(out, "index.html"), "w") as f:
