@@ -105,6 +105,33 @@ TEST(ReportCli, WrongShapeNamesTheKeyExit2) {
   fs::remove_all(d);
 }
 
+// golden check --json (the report's golden section): one row per scene with
+// the same verdict as the exit code, written on failure too.
+TEST(GoldenJson, RowPerSceneWithStatusAlsoOnFailure) {
+  const fs::path d = fresh_dir("golden");
+  auto r = run_rayaudit("golden check doc000-pyramid --json " + (d / "g.json").string() + " --diff-dir " +
+                        (d / "diffs").string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  auto j = nlohmann::json::parse(slurp(d / "g.json"));
+  ASSERT_EQ(j["scenes"].size(), 1u);
+  EXPECT_EQ(j["scenes"][0]["name"], "doc000-pyramid");
+  EXPECT_EQ(j["scenes"][0]["status"], "ok");
+  // A checkout whose golden image differs: copy the repository's scene and
+  // manifest, with another scene's PNG standing in for the golden.
+  const fs::path root = d / "root";
+  fs::create_directories(root / "golden");
+  fs::copy(RAYAUDIT_SOURCE_DIR "/scenes", root / "scenes", fs::copy_options::recursive);
+  fs::copy_file(RAYAUDIT_SOURCE_DIR "/golden/manifest.json", root / "golden" / "manifest.json");
+  fs::copy_file(RAYAUDIT_SOURCE_DIR "/golden/doc004-cube.png", root / "golden" / "doc000-pyramid.png");
+  r = run_rayaudit("golden check doc000-pyramid --root " + root.string() + " --json " + (d / "g2.json").string() +
+                   " --diff-dir " + (d / "diffs").string());
+  EXPECT_EQ(r.code, 1) << r.all;
+  j = nlohmann::json::parse(slurp(d / "g2.json"));
+  ASSERT_EQ(j["scenes"].size(), 1u);
+  EXPECT_EQ(j["scenes"][0]["status"], "fail");
+  fs::remove_all(d);
+}
+
 TEST(CrackMapsCli, BadOffsetAndOpenMeshExit2NothingWritten) {
   const fs::path d = fresh_dir("crackbad");
   auto r = run_rayaudit("crack-maps -o " + (d / "cm").string() + " --offsets 1,abc --mesh " RAYAUDIT_SOURCE_DIR
