@@ -2,7 +2,9 @@
 // (validation/golden.h). check renders and compares (exit 1 on any
 // difference, writing a diff image); bless rewrites goldens, only when asked.
 #include <iostream>
+#include <nlohmann/json.hpp>
 
+#include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "golden.h"
@@ -12,7 +14,7 @@ namespace {
 struct Args {
   std::vector<std::string> scenes;
   std::string root = RAYAUDIT_SOURCE_DIR;
-  std::string diff_dir;
+  std::string diff_dir, json;
   bool skip_unavailable = false;
 };
 
@@ -42,10 +44,12 @@ void check_root(const Args& a) {
 
 void check(const Args& a) {
   check_root(a);
+  ra::OutputBatch outputs({a.json});
   const ra::GoldenSet set(a.root);
   const std::filesystem::path diff_dir =
       a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden" : std::filesystem::path(a.diff_dir);
   int failed = 0, skipped = 0;
+  nlohmann::json rows = nlohmann::json::array();  // for --json (the report's golden section)
   const auto names = names_of(a.scenes, set);
   if (names.empty())
     throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
@@ -53,14 +57,22 @@ void check(const Args& a) {
   for (const auto& n : names) {
     const auto missing = ra::missing_cache_inputs(std::filesystem::path(a.root) / "scenes" / (n + ".json"));
     if (a.skip_unavailable && !missing.empty()) {
-      std::cout << "skip " << n << ": needs " << missing[0].string()
-                << ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)\n";
+      const std::string why = "needs " + missing[0].string() +
+                              ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)";
+      std::cout << "skip " << n << ": " << why << "\n";
+      rows.push_back({{"name", n}, {"status", "skip"}, {"message", why}});
       ++skipped;
       continue;
     }
     const auto r = set.check(n, diff_dir);
     std::cout << (r.pass ? "ok   " : "FAIL ") << r.message << "\n";
+    rows.push_back({{"name", n}, {"status", r.pass ? "ok" : "fail"}, {"message", r.message}});
     failed += !r.pass;
+  }
+  // Written whatever the verdict: a failed check is what the report must show.
+  if (!a.json.empty()) {
+    ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1) + "\n");
+    outputs.commit();
   }
   if (failed)
     throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
@@ -87,6 +99,7 @@ void setup(CLI::App& app) {
       sub->add_option("--diff-dir", args->diff_dir, "Where to write diff images on failure (default /tmp/rayaudit-golden)");
       sub->add_flag("--skip-unavailable", args->skip_unavailable,
                     "Skip scenes whose ${cache} inputs are missing; exit 77 when all were skipped");
+      sub->add_option("--json", args->json, "Write each scene's status (ok, fail, skip) and message as JSON");
     }
     sub->callback([args, fn] { fn(*args); });
   };

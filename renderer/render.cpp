@@ -693,6 +693,9 @@ Tracer::~Tracer() = default;
 
 Color Tracer::trace(const Ray<double>& ray) const { return impl_->trace(ray, 1, 1.0); }
 std::optional<SceneHit> Tracer::intersect(const Ray<double>& ray) const { return impl_->intersect(ray); }
+bool Tracer::occluded(const Ray<double>& ray) const {
+  return impl_->opt.use_double ? impl_->occluded<double>(ray) : impl_->occluded<float>(static_cast<Ray<float>>(ray));
+}
 Color Tracer::pixel(int i, int j) const { return impl_->pixel(i, j); }
 std::optional<Tracer::ShadingPoint> Tracer::shading_point(const Ray<double>& ray) const {
   const auto hit = impl_->intersect(ray);

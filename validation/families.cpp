@@ -463,6 +463,13 @@ void secondary_case(Rng& g, int sweep, TriangleBatch& b) {
 
 }  // namespace
 
+std::vector<Tri> closed_mesh_triangles(int shape) {
+  const Mesh& m = closed_mesh(shape);
+  std::vector<Tri> out;
+  for (const auto& f : m.f) out.push_back({m.v[std::size_t(f[0])], m.v[std::size_t(f[1])], m.v[std::size_t(f[2])]});
+  return out;
+}
+
 int secondary_strategy(int sweep) { return sweep / int(kSecondaryScales.size()); }
 
 int Family::tris_per_probe(int sweep_index) const {

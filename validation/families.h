@@ -74,6 +74,11 @@ void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int
 // the same way (no fold seen along d, none edge-on or degenerate).
 bool group_is_proper(const Tri* tris, int count, const Vec3d& d);
 
+// The closed-mesh family's meshes as triangles around the origin, before any
+// placement or grid snapping: shape 0 is the tessellated sphere (80
+// triangles, radius 2), 1 the cube [-1, 1]^3 (12). Outward winding.
+std::vector<Tri> closed_mesh_triangles(int shape);
+
 // The secondary family's sweep index = strategy * scales + scale index.
 int secondary_strategy(int sweep);
 

@@ -1,0 +1,169 @@
+// `rayaudit bench` run as a user would (issue 13): the JSON of a small
+// --quick subset holds every group with the names and counters the issue
+// fixes, and bad input is one line, exit 2, nothing written. No timings are
+// asserted (those belong in the benchmark's output).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+
+#include "run_rayaudit.h"
+#include "scene_mesh.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using ra::test::run_rayaudit;
+
+fs::path temp_json(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("rayaudit-bench-test-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  fs::remove(p);
+  return p;
+}
+
+bool corpus_present() { return fs::exists(ra::cache_dir() / "corpus" / "ladder" / "bunny_glmark2.obj"); }
+
+int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+// One row of every kind the issue names; one repetition (the flag passes
+// through to Google Benchmark).
+const char* const kSubset =
+    "^(kernel/(moller|watertight)/float/(cull|nocull)/hit=50/back=(0|100)"
+    "|kernel/stable/double/nocull/hit=50/back=0|kernel/plane/double/nocull/hit=50/back=0"
+    "|scene/box/(none|sphere|bvh)/(cull|nocull)/(primary|shadow)/threads=1"
+    "|peer/embree/bunny/(primary|shadow|build)/default/threads=1"
+    "|peer/cgal/bunny/(primary|shadow)/threads=1|peer/tinyobjloader/bunny_glmark2|peer/pov/bunny/threads=1"
+    "|oracle/random/threads=1|obj/bunny_glmark2/serial)$";
+
+TEST(BenchCli, QuickSubsetHasEveryGroupNamesAndCounters) {
+  if (!corpus_present()) GTEST_SKIP() << "mesh corpus not fetched (ci/fetch-corpus.sh)";
+  const fs::path out = temp_json("subset.json");
+  const auto r = run_rayaudit(std::string("bench --quick --benchmark_repetitions=1 --json ") + out.string() +
+                              " --filter '" + kSubset + "'");
+  ASSERT_EQ(r.code, 0) << r.all;
+  ASSERT_TRUE(fs::exists(out));
+  std::ifstream in(out);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_TRUE(j.contains("context"));  // Google Benchmark's format (compare.py reads it)
+  std::map<std::string, nlohmann::json> rows;
+  for (const auto& b : j.at("benchmarks")) {
+    EXPECT_FALSE(b.value("error_occurred", false)) << b.dump();
+    rows[b.at("name").get<std::string>()] = b;
+  }
+  const std::regex kernel("^kernel/[a-z0-9_-]+/(float|double)/(cull|nocull)/hit=(0|10|50|90|100)/back=(0|50|100)$");
+  const std::regex scene("^scene/[a-z-]+/(none|sphere|bvh)/(cull|nocull)/(primary|shadow)/threads=[0-9]+$");
+  const std::regex peer("^peer/(embree|pov|tinyobjloader|cgal)/.+$");
+  const std::regex oracle("^oracle/[a-z-]+/threads=[0-9]+$");
+  const std::regex obj("^obj/[A-Za-z0-9_-]+/(serial|parallel)$");
+  std::map<std::string, int> groups;
+  for (const auto& [name, b] : rows) {
+    const std::string group = name.substr(0, name.find('/'));
+    ++groups[group];
+    const auto& c = b;
+    auto has = [&](const char* counter) { EXPECT_TRUE(c.contains(counter)) << name << " lacks " << counter; };
+    if (group == "kernel") {
+      EXPECT_TRUE(std::regex_match(name, kernel)) << name;
+      has("ns_per_test");
+    } else if (group == "scene") {
+      EXPECT_TRUE(std::regex_match(name, scene)) << name;
+      for (const char* k : {"Mrays_per_s", "triangles", "hits", "build_s", "bytes_per_triangle"}) has(k);
+    } else if (group == "peer") {
+      EXPECT_TRUE(std::regex_match(name, peer)) << name;
+      ASSERT_TRUE(c.contains("ratio")) << name;
+      EXPECT_GT(c.at("ratio").get<double>(), 0) << name;
+    } else if (group == "oracle") {
+      EXPECT_TRUE(std::regex_match(name, oracle)) << name;
+      has("cases/s");
+    } else if (group == "obj") {
+      EXPECT_TRUE(std::regex_match(name, obj)) << name;
+    } else {
+      ADD_FAILURE() << "row outside the five groups: " << name;
+    }
+  }
+  for (const char* g : {"kernel", "scene", "peer", "oracle", "obj"}) EXPECT_GT(groups[g], 0) << g;
+  // Exactly the rows asked for: 8 + 2 kernel, 3 accels x 2 culls x 2 ray kinds (the box is closed).
+  EXPECT_EQ(groups["kernel"], 10);
+  EXPECT_EQ(groups["scene"], 12);
+  for (const char* p : {"peer/embree/bunny/primary/default/threads=1", "peer/embree/bunny/shadow/default/threads=1",
+                        "peer/embree/bunny/build/default/threads=1", "peer/cgal/bunny/primary/threads=1",
+                        "peer/cgal/bunny/shadow/threads=1", "peer/tinyobjloader/bunny_glmark2",
+                        "peer/pov/bunny/threads=1"})
+    EXPECT_TRUE(rows.count(p)) << p;
+
+  // Culling changes the answer where rays meet back faces, not elsewhere.
+  auto counter = [&](const std::string& name, const char* k) { return rows.at(name).at(k).get<double>(); };
+  EXPECT_EQ(counter("kernel/moller/float/nocull/hit=50/back=100", "hit_rate"), 0.5);
+  EXPECT_EQ(counter("kernel/moller/float/cull/hit=50/back=100", "hit_rate"), 0.0);
+  EXPECT_EQ(counter("kernel/moller/float/cull/hit=50/back=0", "hit_rate"), 0.5);
+  // On the closed box, culling and the bounding sphere never change what a ray hits.
+  for (const char* kind : {"primary", "shadow"}) {
+    const std::string tail = std::string("/") + kind + "/threads=1";
+    const double none = counter("scene/box/none/nocull" + tail, "hits");
+    for (const char* v : {"none/cull", "sphere/nocull", "sphere/cull"})
+      EXPECT_EQ(counter(std::string("scene/box/") + v + tail, "hits"), none) << v << tail;
+  }
+  EXPECT_GT(counter("scene/box/none/nocull/primary/threads=1", "hits"), 0);
+  EXPECT_EQ(counter("scene/box/bvh/nocull/primary/threads=1", "triangles"), 12);
+
+  // Embree and ours agree on which rays hit, except rays within rounding of
+  // an edge (Embree's float vertices against our doubles): at most 1 in 10,000.
+  for (const char* p : {"peer/embree/bunny/primary/default/threads=1", "peer/embree/bunny/shadow/default/threads=1",
+                        "peer/cgal/bunny/primary/threads=1", "peer/cgal/bunny/shadow/threads=1"}) {
+    const double rays = counter(p, "rays"), differ = counter(p, "differ");
+    EXPECT_GT(counter(p, "hits"), 0) << p;
+    EXPECT_LE(differ, std::max(1.0, rays / 10000)) << p;
+    EXPECT_LE(std::abs(counter(p, "hits") - counter(p, "ours_hits")), differ) << p;
+  }
+  for (const char* k : {"pov_parse_s", "pov_trace_s", "pov_process_s", "ours_trace_s"})
+    EXPECT_GT(counter("peer/pov/bunny/threads=1", k), 0) << k;
+  EXPECT_NE(r.out.find("rays differ"), std::string::npos) << "the hit-count agreement is printed";
+}
+
+// Bad input: one line on stderr, exit 2, the --json file not written.
+void expect_refused(const std::string& args, const std::string& message, const std::string& env = "") {
+  const fs::path out = temp_json("refused.json");
+  const auto r = run_rayaudit("bench --quick --json " + out.string() + " " + args, env);
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // No temporary left beside it either.
+  for (const auto& e : fs::directory_iterator(out.parent_path()))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+}
+
+TEST(BenchCli, UnknownFilterGroupIsRefused) {
+  expect_refused("--filter 'kernal/moller'", "unknown group \"kernal\"");
+  expect_refused("--filter nothing-matches-this", "selects no benchmark");
+  expect_refused("--filter '('", "not a regular expression");
+}
+
+TEST(BenchCli, UnwritableJsonIsRefused) {
+  const auto r = run_rayaudit("bench --quick --json /nonexistent-dir/b.json --filter kernel/moller/float/cull/hit=0/back=0");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent-dir/b.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists("/nonexistent-dir/b.json"));
+}
+
+TEST(BenchCli, MissingCorpusFileIsNamed) {
+  const fs::path empty = fs::temp_directory_path() / ("rayaudit-bench-empty-cache-" + std::to_string(::getpid()));
+  fs::create_directories(empty);
+  expect_refused("--filter scene/box/", (empty / "corpus/ladder/box.obj").string() + ": missing from the mesh corpus: "
+                 "ci/fetch-corpus.sh fetches it", "RAYAUDIT_CACHE=" + empty.string());
+  fs::remove_all(empty);
+}
+
+TEST(BenchCli, OtherArgumentsAreRefused) {
+  expect_refused("--bogus", "unknown argument \"--bogus\"");
+  expect_refused("--benchmark_out=x.json", "use --json OUT");
+  expect_refused("--threads 0", "--threads");
+}
+
+}  // namespace

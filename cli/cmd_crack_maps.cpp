@@ -1,0 +1,159 @@
+// `rayaudit crack-maps -o DIR`: closed meshes rendered far from the origin
+// with each triangle method in float, leaks painted red (validation/crack_maps.h).
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "atomic_file.h"
+#include "command.h"
+#include "crack_maps.h"
+#include "errors.h"
+#include "scene_mesh.h"
+
+namespace {
+
+struct Args {
+  std::string out;
+  std::vector<std::string> meshes;
+  std::string offsets = "1,1e3,1e5,1e7", methods;
+  int size = 96, threads = 0;
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char ch : s + ",") {
+    if (ch == ',') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else if (ch != ' ') {
+      cur += ch;
+    }
+  }
+  return out;
+}
+
+std::vector<double> parse_offsets(const std::string& list) {
+  std::vector<double> out;
+  for (const auto& s : split(list)) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != s.size() || !std::isfinite(v) || v < 0 || v > 1e30)
+      throw ra::InputError("--offsets: '" + s + "' is not an offset between 0 and 1e30");
+    out.push_back(v);
+  }
+  if (out.empty()) throw ra::InputError("--offsets: give at least one offset");
+  return out;
+}
+
+// "1", "1e3", "1e7", "2.5e4": short, and safe in a file name.
+std::string offset_label(double v) {
+  const double e = std::round(std::log10(v));
+  if (v > 0 && e >= 3 && v == std::pow(10.0, e)) return "1e" + std::to_string(int(e));
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  std::string s = buf;
+  for (char& c : s)
+    if (c == '+') c = 'p';
+  return s;
+}
+
+// The ladder's closed mesh the maps use unless --mesh is given.
+std::filesystem::path default_ladder_mesh() { return ra::cache_dir() / "corpus" / "ladder" / "elephant_cgal.obj"; }
+
+std::function<void(std::size_t, std::size_t)> progress_count() {
+  if (!isatty(STDERR_FILENO)) return {};
+  return [](std::size_t done, std::size_t total) {
+    std::fprintf(stderr, "\rcrack maps: %zu/%zu mesh x offset", done, total);
+    if (done == total) std::fprintf(stderr, "\r%40s\r", "");
+    std::fflush(stderr);
+  };
+}
+
+void run(const Args& a) {
+  if (a.size < 8 || a.size > 1024) throw ra::InputError("--size must be 8 to 1024 pixels");
+  ra::crack::Options opt;
+  opt.size = a.size;
+  opt.threads = a.threads;
+  opt.offsets = parse_offsets(a.offsets);
+  opt.methods = split(a.methods);
+  opt.progress = progress_count();
+  const std::filesystem::path dir(a.out);
+  if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))
+    throw ra::InputError(a.out + ": exists and is not a directory");
+  const std::filesystem::path parent = std::filesystem::absolute(dir).parent_path();
+  if (!std::filesystem::is_directory(parent)) throw ra::InputError(a.out + ": its parent directory does not exist");
+
+  std::vector<ra::crack::ClosedMesh> meshes{ra::crack::audit_sphere()};
+  if (a.meshes.empty()) {
+    const auto f = default_ladder_mesh();
+    if (!std::filesystem::exists(f))
+      throw ra::InputError(f.string() + ": missing (ci/fetch-corpus.sh fetches the mesh ladder)");
+    meshes.push_back(ra::crack::closed_obj(f));
+  }
+  for (const auto& m : a.meshes) meshes.push_back(ra::crack::closed_obj(m));
+
+  const auto maps = ra::crack::render_maps(meshes, opt);  // throws on an unknown method, before writing
+
+  std::filesystem::create_directories(dir);
+  std::vector<std::filesystem::path> outputs{dir / "crack_maps.json"};
+  for (const auto& m : maps) outputs.push_back(dir / (m.mesh + "-" + m.method + "-" + offset_label(m.offset) + ".png"));
+  ra::OutputBatch batch(outputs);
+  nlohmann::json j = {{"size", opt.size},
+                      {"precision", "float"},
+                      {"offsets", opt.offsets},
+                      {"legend",
+                       "grey: hit (shaded by angle); red: leak (the oracle or the watertight method finds a crossing, "
+                       "this method none); blue: hit where the oracle finds no crossing; white: background"}};
+  nlohmann::json ms = nlohmann::json::array(), entries = nlohmann::json::array();
+  for (const auto& m : meshes)
+    ms.push_back({{"name", m.name}, {"source", m.source}, {"triangles", m.faces.size()}});
+  j["meshes"] = ms;
+  std::printf("%-14s %-16s %10s %8s %8s %8s\n", "MESH", "METHOD", "OFFSET", "SURFACE", "LEAKS", "F.HITS");
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    const auto& m = maps[i];
+    ra::write_image(outputs[i + 1], m.image);
+    entries.push_back({{"mesh", m.mesh},
+                       {"method", m.method},
+                       {"precision", "float"},
+                       {"offset", m.offset},
+                       {"pixels", m.pixels},
+                       {"surface_pixels", m.surface},
+                       {"leaks", m.leaks},
+                       {"false_hits", m.false_hits},
+                       {"image", outputs[i + 1].filename().string()}});
+    std::printf("%-14s %-16s %10g %8lld %8lld %8lld\n", m.mesh.c_str(), m.method.c_str(), m.offset, m.surface,
+                m.leaks, m.false_hits);
+  }
+  j["maps"] = entries;
+  ra::write_text_atomically(outputs[0], j.dump(1) + "\n");
+  batch.commit();
+  std::cout << "wrote " << maps.size() << " maps and crack_maps.json into " << a.out << "\n";
+}
+
+void setup(CLI::App& app) {
+  auto a = std::make_shared<Args>();
+  auto* cmd = app.add_subcommand(
+      "crack-maps", "Render closed meshes far from the origin with each triangle method in float; paint leaks red");
+  cmd->add_option("-o,--out", a->out, "Directory for crack_maps.json and one PNG per mesh x method x offset")
+      ->required();
+  cmd->add_option("--mesh", a->meshes,
+                  "A closed OBJ to map besides the audit's sphere (default: the ladder's elephant_cgal.obj, 5,558 triangles)");
+  cmd->add_option("--offsets", a->offsets, "Comma-separated offsets of the mesh centre (o, o, o)")->capture_default_str();
+  cmd->add_option("--methods", a->methods, "Comma-separated triangle methods (default: all)");
+  cmd->add_option("--size", a->size, "Pixels a side")->capture_default_str();
+  cmd->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+  cmd->callback([a] { run(*a); });
+}
+
+ra::cli::Registrar reg(35, setup);
+
+}  // namespace

@@ -1,0 +1,302 @@
+// `rayaudit report`: the main job's product (issue 14). Checks every input
+// here, then validation/report/report.py (matplotlib) draws the page.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "atomic_file.h"
+#include "command.h"
+#include "errors.h"
+#include "registry.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Args {
+  std::string audit, bench, crack_maps, golden, stages, out;
+  std::vector<std::string> compare;
+};
+
+// Debian's matplotlib is installed for the system interpreter only.
+std::string python() {
+  const char* p = std::getenv("RAYAUDIT_PYTHON");
+  return p && *p ? p : "/usr/bin/python3";
+}
+fs::path script() { return fs::path(RAYAUDIT_SOURCE_DIR) / "validation" / "report" / "report.py"; }
+
+std::string read_file(const fs::path& f) {
+  if (!fs::exists(f)) throw ra::InputError(f.string() + ": no such file");
+  if (!fs::is_regular_file(f)) throw ra::InputError(f.string() + ": not a regular file");
+  std::ifstream in(f, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (!in && !in.eof()) throw ra::InputError(f.string() + ": cannot read");
+  return ss.str();
+}
+
+// Google Benchmark writes NaN and Infinity (e.g. the cv of a constant
+// counter), which JSON lacks: outside strings they become null, keeping lines.
+std::string gbench_non_finite_to_null(const std::string& in) {
+  std::string out;
+  bool str = false;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const char c = in[i];
+    if (str) {
+      out += c;
+      if (c == '\\' && i + 1 < in.size()) out += in[++i];
+      else if (c == '"') str = false;
+      continue;
+    }
+    if (c == '"') str = true;
+    bool replaced = false;
+    for (const char* tok : {"-Infinity", "Infinity", "NaN", "-nan", "nan", "-inf", "inf"}) {
+      const std::size_t n = std::strlen(tok);
+      if (in.compare(i, n, tok) == 0) {
+        out += "null";
+        i += n - 1;
+        replaced = true;
+        break;
+      }
+    }
+    if (!replaced) out += c;
+  }
+  return out;
+}
+
+// Parses a JSON file; a syntax error names the file and line.
+json read_json(const fs::path& f, bool gbench = false) {
+  const std::string text = gbench ? gbench_non_finite_to_null(read_file(f)) : read_file(f);
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    const std::size_t at = std::min<std::size_t>(e.byte ? e.byte - 1 : 0, text.size());
+    const int line = 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(at), '\n'));
+    std::string what = e.what();
+    if (const auto p = what.find("syntax error"); p != std::string::npos) what = what.substr(p);
+    throw ra::InputError(ra::located(f.string(), line, "malformed JSON: " + what));
+  }
+}
+
+// `j` at `path` must hold `key` of the given type ("object", "array", "number", "string").
+const json& need(const fs::path& f, const json& j, const std::string& where, const std::string& key,
+                 const std::string& type) {
+  if (!j.is_object() || !j.contains(key))
+    throw ra::InputError(f.string() + ": " + (where.empty() ? "" : where + ": ") + "missing '" + key + "'");
+  const json& v = j.at(key);
+  const bool ok = type == "object" ? v.is_object() : type == "array" ? v.is_array()
+                : type == "number" ? v.is_number() : type == "string" ? v.is_string() : v.is_boolean();
+  if (!ok) throw ra::InputError(f.string() + ": " + (where.empty() ? "" : where + ": ") + "'" + key + "' is not a " + type);
+  return v;
+}
+
+void check_audit(const fs::path& f) {
+  const json j = read_json(f);
+  if (!j.is_object()) throw ra::InputError(f.string() + ": not an audit JSON (rayaudit audit --json): not an object");
+  if (j.contains("cases") && !j.contains("subjects"))
+    throw ra::InputError(f.string() + ": an `audit --cases` output; the report needs the families' audit (rayaudit audit --json)");
+  need(f, j, "", "seed", "number");
+  need(f, j, "", "rays_per_family", "number");
+  const json& subs = need(f, j, "", "subjects", "array");
+  if (subs.empty()) throw ra::InputError(f.string() + ": no subjects");
+  for (std::size_t i = 0; i < subs.size(); ++i) {
+    const std::string at = "subjects[" + std::to_string(i) + "]";
+    for (const char* k : {"name", "method", "precision", "kind"}) need(f, subs[i], at, k, "string");
+    const json& t = need(f, subs[i], at, "totals", "object");
+    for (const char* k : {"tests", "wrong_pct", "leaks", "groups"}) need(f, t, at + ".totals", k, "number");
+  }
+  const json& cells = need(f, j, "", "cells", "array");
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const std::string at = "cells[" + std::to_string(i) + "]";
+    for (const char* k : {"subject", "family", "param", "sweep"}) need(f, cells[i], at, k, "string");
+    const json& s = need(f, cells[i], at, "stats", "object");
+    for (const char* k : {"tests", "wrong_pct", "leaks", "groups", "double_hits", "spawned", "self_hits"})
+      need(f, s, at + ".stats", k, "number");
+  }
+}
+
+void check_bench(const fs::path& f) {
+  const json j = read_json(f, true);
+  const json& bs = need(f, j, "", "benchmarks", "array");
+  need(f, j, "", "context", "object");
+  for (std::size_t i = 0; i < bs.size(); ++i) {
+    const std::string at = "benchmarks[" + std::to_string(i) + "]";
+    need(f, bs[i], at, "name", "string");
+    for (const char* k : {"ns_per_test", "Mrays_per_s", "ratio", "triangles"})
+      if (bs[i].contains(k) && !bs[i][k].is_number() && !bs[i][k].is_null())
+        throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is not a number");
+  }
+}
+
+void check_compare_dir(const fs::path& d) {
+  if (!fs::is_directory(d)) throw ra::InputError(d.string() + ": not a directory (--compare takes a directory of `compare --json` outputs)");
+  int found = 0;
+  for (const auto& e : fs::directory_iterator(d)) {
+    if (e.path().extension() != ".json") continue;
+    const json j = read_json(e.path());
+    for (const char* k : {"width", "height", "differing"}) need(e.path(), j, "", k, "number");
+    need(e.path(), j, "", "identical", "boolean");
+    const json& ds = need(e.path(), j, "", "differences", "array");
+    for (std::size_t i = 0; i < ds.size(); ++i)
+      for (const char* k : {"x", "y", "levels"}) need(e.path(), ds[i], "differences[" + std::to_string(i) + "]", k, "number");
+    if (j.contains("explanations")) {
+      const json& ex = need(e.path(), j, "", "explanations", "array");
+      for (std::size_t i = 0; i < ex.size(); ++i) {
+        const std::string at = "explanations[" + std::to_string(i) + "]";
+        for (const char* k : {"x", "y"}) need(e.path(), ex[i], at, k, "number");
+        need(e.path(), ex[i], at, "cause", "string");
+      }
+    }
+    ++found;
+  }
+  if (!found) throw ra::InputError(d.string() + ": no compare JSON in this directory (rayaudit compare SCENE --json DIR/NAME.json)");
+}
+
+void check_crack_maps(const fs::path& d) {
+  if (!fs::is_directory(d)) throw ra::InputError(d.string() + ": not a directory (--crack-maps takes `rayaudit crack-maps -o DIR`'s DIR)");
+  const fs::path f = d / "crack_maps.json";
+  const json j = read_json(f);
+  need(f, j, "", "legend", "string");
+  const json& ms = need(f, j, "", "meshes", "array");
+  for (std::size_t i = 0; i < ms.size(); ++i) {
+    need(f, ms[i], "meshes[" + std::to_string(i) + "]", "name", "string");
+    need(f, ms[i], "meshes[" + std::to_string(i) + "]", "source", "string");
+  }
+  const json& maps = need(f, j, "", "maps", "array");
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    const std::string at = "maps[" + std::to_string(i) + "]";
+    for (const char* k : {"mesh", "method", "precision", "image"}) need(f, maps[i], at, k, "string");
+    for (const char* k : {"offset", "pixels", "surface_pixels", "leaks", "false_hits"}) need(f, maps[i], at, k, "number");
+    const fs::path img = d / maps[i]["image"].get<std::string>();
+    if (!fs::is_regular_file(img)) throw ra::InputError(f.string() + ": " + at + ": image " + img.string() + " is missing");
+  }
+}
+
+void check_golden(const fs::path& f) {
+  const json j = read_json(f);
+  const json& ss = need(f, j, "", "scenes", "array");
+  for (std::size_t i = 0; i < ss.size(); ++i)
+    for (const char* k : {"name", "status", "message"}) need(f, ss[i], "scenes[" + std::to_string(i) + "]", k, "string");
+}
+
+// ci/main.sh's stage timings: one "NAME<TAB>SECONDS" a line.
+void check_stages(const fs::path& f) {
+  std::istringstream in(read_file(f));
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (line.empty()) continue;
+    const auto tab = line.rfind('\t');
+    char* end = nullptr;
+    if (tab != std::string::npos) std::strtod(line.c_str() + tab + 1, &end);
+    if (tab == std::string::npos || tab == 0 || !end || *end != '\0' || end == line.c_str() + tab + 1)
+      throw ra::InputError(ra::located(f.string(), n, "expected STAGE<TAB>SECONDS"));
+  }
+}
+
+json methods_json() {
+  json out = json::array();
+  for (const auto& m : ra::methods())
+    out.push_back({{"name", m.name}, {"kind", std::string(ra::kind_name(m.kind))}, {"source", m.source},
+                   {"description", m.description}, {"wrong_on_purpose", m.wrong_on_purpose}});
+  return out;
+}
+
+std::string absolute(const std::string& p) { return p.empty() ? p : fs::absolute(p).lexically_normal().string(); }
+
+// Runs the page script; its stderr passes through. Returns its exit status.
+int run_script(const fs::path& ctx) {
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("report: cannot start " + python());
+  if (pid == 0) {
+    const std::string py = python(), sc = script().string(), c = ctx.string();
+    execl(py.c_str(), py.c_str(), sc.c_str(), c.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+void run(const Args& a) {
+  // Every input and destination is checked before anything is drawn.
+  const fs::path dir(a.out);
+  if (fs::exists(dir) && !fs::is_directory(dir)) throw ra::InputError(a.out + ": exists and is not a directory");
+  if (!fs::is_directory(fs::absolute(dir).parent_path()))
+    throw ra::InputError(a.out + ": its parent directory does not exist");
+  check_audit(a.audit);
+  if (!a.bench.empty()) check_bench(a.bench);
+  for (const auto& d : a.compare) check_compare_dir(d);
+  if (!a.crack_maps.empty()) check_crack_maps(a.crack_maps);
+  if (!a.golden.empty()) check_golden(a.golden);
+  if (!a.stages.empty()) check_stages(a.stages);
+  if (access(python().c_str(), X_OK) != 0)
+    throw ra::InputError(python() + ": not found (the report needs Debian's python3-matplotlib; ci/install-deps.sh)");
+  if (!fs::is_regular_file(script())) throw ra::InputError(script().string() + ": the report script is missing");
+
+  char tmpl[] = "/tmp/rayaudit-report-XXXXXX";
+  if (!mkdtemp(tmpl)) throw std::runtime_error("report: cannot make a temporary directory");
+  const fs::path tmp(tmpl);
+  struct Cleanup {
+    fs::path p;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(p, ec);
+    }
+  } cleanup{tmp};
+  json compare = json::array();
+  for (const auto& d : a.compare) compare.push_back(absolute(d));
+  const json ctx = {{"audit", absolute(a.audit)},
+                    {"bench", a.bench.empty() ? json(nullptr) : json(absolute(a.bench))},
+                    {"compare", compare},
+                    {"crack_maps", a.crack_maps.empty() ? json(nullptr) : json(absolute(a.crack_maps))},
+                    {"golden", a.golden.empty() ? json(nullptr) : json(absolute(a.golden))},
+                    {"stages", a.stages.empty() ? json(nullptr) : json(absolute(a.stages))},
+                    {"methods", methods_json()},
+                    {"source_dir", RAYAUDIT_SOURCE_DIR},
+                    {"build",
+                     {{"compiler", RAYAUDIT_COMPILER},
+                      {"flags", RAYAUDIT_CXX_FLAGS},
+                      {"build_type", RAYAUDIT_BUILD_TYPE},
+                      {"version", std::string("rayaudit ") + RAYAUDIT_VERSION}}},
+                    {"out_dir", tmp.string()}};
+  std::ofstream(tmp / "context.json") << ctx.dump(1);
+  if (const int rc = run_script(tmp / "context.json"); rc != 0)
+    throw std::runtime_error("report: " + script().string() + " failed (exit " + std::to_string(rc) + ")");
+  const std::string page = read_file(tmp / "index.html"), data = read_file(tmp / "report.json");
+
+  fs::create_directories(dir);
+  ra::OutputBatch outputs({dir / "index.html", dir / "report.json"});
+  ra::write_text_atomically(dir / "index.html", page);
+  ra::write_text_atomically(dir / "report.json", data);
+  outputs.commit();
+  std::cout << "wrote " << (dir / "index.html").string() << " (" << page.size() / 1024 << " KiB) and "
+            << (dir / "report.json").string() << "\n";
+}
+
+void setup(CLI::App& app) {
+  auto a = std::make_shared<Args>();
+  auto* cmd = app.add_subcommand("report",
+                                 "One self-contained HTML page (and report.json) from earlier outputs: speed against "
+                                 "accuracy, stability, crack maps, optimisations, peers, images");
+  cmd->add_option("--audit", a->audit, "rayaudit audit --json output")->required();
+  cmd->add_option("--bench", a->bench, "rayaudit bench --json output (Google Benchmark JSON)");
+  cmd->add_option("--compare", a->compare,
+                  "Directory of rayaudit compare --json outputs, with NAME-ours.png, NAME-pov.png, NAME-diff.png "
+                  "beside them (repeatable)");
+  cmd->add_option("--crack-maps", a->crack_maps, "Directory written by rayaudit crack-maps");
+  cmd->add_option("--golden", a->golden, "rayaudit golden check --json output");
+  cmd->add_option("--stages", a->stages, "Stage timings (STAGE<TAB>SECONDS lines, as ci/main.sh writes)");
+  cmd->add_option("-o,--out", a->out, "Directory for index.html and report.json")->required();
+  cmd->callback([a] { run(*a); });
+}
+
+ra::cli::Registrar reg(90, setup);
+
+}  // namespace

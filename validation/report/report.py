@@ -1,0 +1,898 @@
+#!/usr/bin/python3
+# The report page (issue 14): charts drawn by matplotlib as inline SVG, thumbnails
+# as data: URIs, one self-contained index.html and the report.json behind it.
+#
+# Run by `rayaudit report` (cli/cmd_report.cpp) with /usr/bin/python3, which has
+# Debian's matplotlib; that command has already checked every input, so this
+# script trusts their shape and reads them as given in CONTEXT.json.
+import base64
+import datetime
+import glob
+import html
+import io
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("svg")
+import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
+import numpy as np  # noqa: E402
+from PIL import Image, ImageDraw  # noqa: E402
+
+plt.rcParams.update({
+    "svg.fonttype": "none",  # text stays text: smaller and searchable
+    "font.size": 9,
+    "axes.titlesize": 10,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "figure.dpi": 96,
+    "figure.constrained_layout.use": True,
+})
+
+THUMB = 160  # largest side of an image thumbnail, pixels
+ZERO_FLOOR = 1e-5  # where "0 %" is drawn on a log axis
+
+# ------------------------------------------------------------------ helpers --
+
+
+def svg_of(fig):
+    buf = io.StringIO()
+    fig.savefig(buf, format="svg", bbox_inches="tight")
+    plt.close(fig)
+    text = buf.getvalue()
+    # Keep only the <svg> element (drop the XML prolog and DOCTYPE).
+    return text[text.index("<svg"):]
+
+
+def data_uri(path, max_side=THUMB, marks=()):
+    """A PNG thumbnail as a data: URI; `marks` (x, y) pixels of the original
+    are ringed, so a single differing pixel still shows after shrinking."""
+    with Image.open(path) as im:
+        im = im.convert("RGB")
+        w0 = im.size[0]
+        if max(im.size) > max_side:
+            im.thumbnail((max_side, max_side), Image.NEAREST)
+        if marks:
+            draw = ImageDraw.Draw(im)
+            k = im.size[0] / w0
+            for x, y in marks:
+                cx, cy = (x + 0.5) * k, (y + 0.5) * k
+                draw.ellipse((cx - 5, cy - 5, cx + 5, cy + 5), outline=(255, 220, 0), width=2)
+        buf = io.BytesIO()
+        im.save(buf, format="PNG", optimize=True)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def esc(s):
+    return html.escape(str(s))
+
+
+def offset_label(v):
+    """1 -> '1', 1000 -> '1e3', 1e7 -> '1e7'."""
+    if v > 0 and v >= 1000 and 10 ** round(math.log10(v)) == v:
+        return f"1e{round(math.log10(v))}"
+    return f"{v:g}"
+
+
+def fnum(v, digits=3):
+    if v is None:
+        return "-"
+    if isinstance(v, float) and (math.isnan(v) or math.isinf(v)):
+        return "-"
+    if v == 0:
+        return "0"
+    a = abs(v)
+    if a >= 1e5 or a < 1e-3:
+        return f"{v:.{digits - 1}e}"
+    return f"{v:.{digits}g}"
+
+
+def sweep_number(label):
+    try:
+        return float(label)
+    except ValueError:
+        return None
+
+
+# ------------------------------------------------------------------- inputs --
+
+
+class Methods:
+    """The registry as rayaudit reports it: colours, and which are the documents'."""
+
+    def __init__(self, methods):
+        self.by_name = {m["name"]: m for m in methods}
+        cmap = plt.get_cmap("tab10")
+        tri = [m["name"] for m in methods if m["kind"] == "triangle"]
+        sph = [m["name"] for m in methods if m["kind"] == "sphere"]
+        self.colour = {}
+        for i, n in enumerate(tri):
+            self.colour[n] = cmap(i % 10)
+        for i, n in enumerate(sph):
+            self.colour[n] = cmap((i + 4) % 10)
+
+    def is_document(self, name):
+        m = self.by_name.get(name)
+        return bool(m) and m["source"].startswith("seeds/")
+
+    def label(self, name):
+        return name + (" (doc)" if self.is_document(name) else "")
+
+
+def bench_rows(bench):
+    """name -> row, preferring the median aggregate over single iterations."""
+    rows = {}
+    for b in (bench or {}).get("benchmarks", []):
+        name = b.get("run_name") or b["name"]
+        if b.get("run_type") == "aggregate":
+            if b.get("aggregate_name") != "median":
+                continue
+            rows[name] = b
+        elif name not in rows or rows[name].get("run_type") != "aggregate":
+            rows.setdefault(name, b)
+    return rows
+
+
+def parse_bench_name(name):
+    """'kernel/moller/float/nocull/hit=50/back=0/real_time' -> (['kernel', ...], {'hit': '50', ...})"""
+    parts, keys = [], {}
+    for p in name.split("/"):
+        if "=" in p:
+            k, v = p.split("=", 1)
+            keys[k] = v
+        elif ":" in p or p in ("real_time", "manual_time"):
+            continue
+        else:
+            parts.append(p)
+    return parts, keys
+
+
+# ---------------------------------------------------------------- section 1 --
+
+
+def speed_accuracy(audit, bench, methods):
+    rows = bench_rows(bench)
+    ns = {}
+    for name, b in rows.items():
+        parts, keys = parse_bench_name(name)
+        if parts[:1] == ["kernel"] and len(parts) >= 4 and parts[3] == "nocull" \
+                and keys.get("hit") == "50" and keys.get("back", "0") == "0" and "ns_per_test" in b:
+            ns[(parts[1], parts[2])] = float(b["ns_per_test"])
+    out = []
+    for s in audit["subjects"]:
+        t = s["totals"]
+        groups = t.get("groups", 0)
+        out.append({
+            "subject": s["name"],
+            "method": s["method"],
+            "precision": s["precision"],
+            "kind": s["kind"],
+            "document_variant": methods.is_document(s["method"]),
+            "ns_per_test": ns.get((s["method"], s["precision"])),
+            "wrong_pct": t["wrong_pct"],
+            "leaks": t.get("leaks", 0),
+            "groups": groups,
+            "leaks_per_million": (1e6 * t.get("leaks", 0) / groups) if groups else None,
+            "tests": t["tests"],
+            "worst": s.get("worst"),
+        })
+    return out
+
+
+def pareto(points):
+    """Indices of the points no other point beats on both x and y (lower is better)."""
+    front = []
+    for i, (x, y) in enumerate(points):
+        if not any((x2 <= x and y2 <= y) and (x2 < x or y2 < y) for j, (x2, y2) in enumerate(points) if j != i):
+            front.append(i)
+    return sorted(front, key=lambda i: points[i][0])
+
+
+def scatter_panel(ax, entries, methods, yfield, ylabel, title):
+    pts = [(e["ns_per_test"], max(e[yfield], ZERO_FLOOR)) for e in entries]
+    for e, (x, y) in zip(entries, pts):
+        doc = e["document_variant"]
+        c = methods.colour.get(e["method"], "k")
+        ax.scatter([x], [y], s=60, marker="o" if e["precision"] == "float" else "s",
+                   facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=3)
+        ax.annotate(("doc: " if doc else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d"),
+                    (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6.5,
+                    color=c, alpha=0.9)
+    front = pareto(pts)
+    if len(front) > 1:
+        ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, alpha=0.6,
+                label="Pareto front (nothing both faster and righter)")
+    elif front:
+        ax.scatter([pts[front[0]][0]], [pts[front[0]][1]], s=220, facecolors="none", edgecolors="k",
+                   label="Pareto front")
+    ax.set_yscale("log")
+    ax.set_xscale("log")
+    ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.tick_params(axis="x", which="minor", labelsize=6.5)
+    if any(e[yfield] == 0 for e in entries):  # zeros sit on a floor line, labelled
+        ax.axhline(ZERO_FLOOR, color="g", lw=0.8, alpha=0.6)
+        ax.text(ax.get_xlim()[0], ZERO_FLOOR, " 0 (none found)", color="g", fontsize=7, va="bottom")
+    ax.set_xlabel("ns per ray/triangle test (log; kernel bench, 50% hits; left is faster)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=7, frameon=False)
+
+
+def chart_speed_accuracy(entries, methods, have_bench):
+    charts = []
+    tri = [e for e in entries if e["kind"] == "triangle"]
+    sph = [e for e in entries if e["kind"] == "sphere"]
+    if have_bench:
+        timed_tri = [e for e in tri if e["ns_per_test"] is not None]
+        timed_sph = [e for e in sph if e["ns_per_test"] is not None]
+        if timed_tri:
+            fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
+            scatter_panel(axes[0], timed_tri, methods, "wrong_pct", "wrong % of tests (log; down is righter)",
+                          "Triangle methods: speed against wrong answers")
+            leak = [e for e in timed_tri if e["leaks_per_million"] is not None]
+            for e in leak:
+                e["_lpm"] = e["leaks_per_million"]
+            scatter_panel(axes[1], [dict(e, wrong_pct=e["_lpm"]) for e in leak], methods, "wrong_pct",
+                          "watertight leaks per million group rays (log)", "Triangle methods: speed against leaks")
+            for e in leak:
+                del e["_lpm"]
+            charts.append((svg_of(fig), "Each point is a method x precision (circle float, square double, hollow = "
+                           "a seed document's method as written). Down-left is better: the dashed line joins the "
+                           "methods nothing else beats on both speed and correctness."))
+        if timed_sph:
+            fig, ax = plt.subplots(figsize=(6, 4.2))
+            scatter_panel(ax, timed_sph, methods, "wrong_pct", "wrong % of tests (log)",
+                          "Sphere methods: speed against wrong answers")
+            charts.append((svg_of(fig), "Sphere methods over the sphere families (huge, tiny-far, near-origin); "
+                           "same reading as above."))
+    else:
+        fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
+        for ax, field, title in ((axes[0], "wrong_pct", "wrong % of tests"),
+                                 (axes[1], "leaks_per_million", "leaks per million group rays")):
+            es = [e for e in entries if e[field] is not None]
+            ys = [max(e[field], ZERO_FLOOR) for e in es]
+            cols = [methods.colour.get(e["method"], "k") for e in es]
+            ax.barh(range(len(es)), ys, color=cols, hatch=None)
+            for i, e in enumerate(es):
+                if e["document_variant"]:
+                    ax.barh([i], [ys[i]], color="none", edgecolor="k", hatch="//")
+            ax.set_yticks(range(len(es)), [methods.label(e["method"]) + "/" + e["precision"] for e in es], fontsize=7)
+            ax.set_xscale("log")
+            ax.invert_yaxis()
+            ax.set_xlabel(title + " (log; shorter is righter; 1e-5 means none)")
+            ax.set_title(title + " (no benchmark given: no speed axis)")
+        charts.append((svg_of(fig), "No benchmark given, so there is no speed axis: correctness only. Hatched bars "
+                       "are the seed documents' methods as written."))
+    return charts
+
+
+# ---------------------------------------------------------------- section 2 --
+
+
+def stability(audit):
+    """family -> list of {sweep, x, subject, method, precision, wrong_pct, leaks, self_hit_pct}."""
+    out = {}
+    for c in audit["cells"]:
+        s = c["stats"]
+        method, prec = c["subject"].rsplit("/", 1)
+        out.setdefault(c["family"], {"param": c["param"], "rows": []})["rows"].append({
+            "sweep": c["sweep"],
+            "subject": c["subject"],
+            "method": method,
+            "precision": prec,
+            "tests": s["tests"],
+            "wrong_pct": s["wrong_pct"],
+            "leaks": s["leaks"],
+            "groups": s["groups"],
+            "double_hits": s["double_hits"],
+            "spawned": s["spawned"],
+            "self_hits": s["self_hits"],
+            "self_hit_pct": (100.0 * s["self_hits"] / s["spawned"]) if s["spawned"] else None,
+        })
+    return out
+
+
+def line_panel(ax, rows, methods, field, sweeps, numeric):
+    xs_of = {sw: (float(sw) if numeric else i) for i, sw in enumerate(sweeps)}
+    for method in dict.fromkeys(r["method"] for r in rows):
+        rs = [r for r in rows if r["method"] == method and r[field] is not None]
+        if not rs:
+            continue
+        rs.sort(key=lambda r: xs_of[r["sweep"]])
+        doc = methods.is_document(method)
+        ax.plot([xs_of[r["sweep"]] for r in rs], [r[field] for r in rs], marker="o", ms=3,
+                ls="--" if doc else "-", color=methods.colour.get(method, "k"), label=methods.label(method))
+    if numeric:
+        if min(xs_of.values()) > 0:
+            ax.set_xscale("log")
+        else:
+            ax.set_xscale("symlog", linthresh=1)
+    else:
+        ax.set_xticks(list(xs_of.values()), sweeps, rotation=30, fontsize=7)
+    ax.set_yscale("symlog", linthresh=1e-3 if field != "leaks" else 1)
+    ax.set_ylim(bottom=0)
+
+
+def chart_stability(stab, methods):
+    charts = []
+    for family, d in stab.items():
+        rows = d["rows"]
+        sweeps = list(dict.fromkeys(r["sweep"] for r in rows))
+        if len(sweeps) < 2:
+            continue
+        precisions = list(dict.fromkeys(r["precision"] for r in rows))
+        secondary = any(r["spawned"] for r in rows)
+        grouped = any(r["groups"] for r in rows)
+        if secondary:
+            # strategy@scale: one row of panels per self-intersection strategy.
+            strategies = list(dict.fromkeys(s.split("@")[0] for s in sweeps))
+            fig, axes = plt.subplots(len(strategies), len(precisions), figsize=(5.2 * len(precisions), 2.4 * len(strategies)),
+                                     squeeze=False, sharey=True)
+            for i, st in enumerate(strategies):
+                for j, p in enumerate(precisions):
+                    rs = [dict(r, sweep=r["sweep"].split("@")[1]) for r in rows
+                          if r["precision"] == p and r["sweep"].split("@")[0] == st]
+                    sw = list(dict.fromkeys(r["sweep"] for r in rs))
+                    line_panel(axes[i][j], rs, methods, "self_hit_pct", sw, True)
+                    axes[i][j].set_title(f"{st}, {p}: self-hit % of secondary rays")
+                    axes[i][j].set_xlabel("scale of the triangle (log)")
+            axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1))
+            caption = ("secondary: rays spawned from each method's own hit under each self-intersection strategy; "
+                       "a self-hit re-hits the triangle it left (shadow acne). Lower is better; 0 is the goal.")
+            charts.append((family, svg_of(fig), caption))
+            continue
+        numeric = all(sweep_number(s) is not None for s in sweeps)
+        fields = [("wrong_pct", "wrong %")]
+        if grouped:
+            fields.append(("leaks", "leaks (rays through a closed group)"))
+        fig, axes = plt.subplots(len(fields), len(precisions), figsize=(5.2 * len(precisions), 2.6 * len(fields)),
+                                 squeeze=False)
+        for i, (field, label) in enumerate(fields):
+            for j, p in enumerate(precisions):
+                rs = [r for r in rows if r["precision"] == p]
+                line_panel(axes[i][j], rs, methods, field, sweeps, numeric)
+                axes[i][j].set_title(f"{family}, {p}: {label}")
+                axes[i][j].set_xlabel(d["param"] + (" (log)" if numeric else ""))
+        # Same y range for float and double so they compare at a glance.
+        for i in range(len(fields)):
+            top = max(ax.get_ylim()[1] for ax in axes[i])
+            for ax in axes[i]:
+                ax.set_ylim(0, top)
+        axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1))
+        how = f"as the {d['param']} grows" if numeric else f"for each {d['param']}"
+        caption = (f"{family}: how each method fares {how}; float left, double right, "
+                   "dashed lines are the seed documents' methods. Flat at 0 is right; a rising line is where "
+                   "that method breaks.")
+        charts.append((family, svg_of(fig), caption))
+    return charts
+
+
+# ---------------------------------------------------------------- section 3 --
+
+
+def crack_maps(cm, cm_dir):
+    out = []
+    for m in cm["maps"]:
+        out.append({k: m[k] for k in ("mesh", "method", "precision", "offset", "pixels", "surface_pixels",
+                                       "leaks", "false_hits")}
+                   | {"image": os.path.join(cm_dir, m["image"])})
+    return out
+
+
+def chart_crack_leaks(maps, methods):
+    meshes = list(dict.fromkeys(m["mesh"] for m in maps))
+    fig, axes = plt.subplots(1, len(meshes), figsize=(5.2 * len(meshes), 3.2), squeeze=False)
+    for ax, mesh in zip(axes[0], meshes):
+        ms = [m for m in maps if m["mesh"] == mesh]
+        for method in dict.fromkeys(m["method"] for m in ms):
+            rs = sorted((m for m in ms if m["method"] == method), key=lambda m: m["offset"])
+            ax.plot([max(m["offset"], 1e-1) for m in rs], [m["leaks"] for m in rs], marker="o", ms=3,
+                    ls="--" if methods.is_document(method) else "-", color=methods.colour.get(method, "k"),
+                    label=methods.label(method))
+        ax.set_xscale("log")
+        ax.set_yscale("symlog", linthresh=1)
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel("offset of the mesh from the origin (log)")
+        ax.set_ylabel("leaking pixels")
+        ax.set_title(f"{mesh}: leaking pixels in float")
+    axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1))
+    return svg_of(fig)
+
+
+# ---------------------------------------------------------------- section 4 --
+
+
+def optimisations(bench):
+    rows = bench_rows(bench)
+    scene = []
+    for name, b in rows.items():
+        parts, keys = parse_bench_name(name)
+        if parts[:1] != ["scene"] or len(parts) < 5 or not b.get("Mrays_per_s"):
+            continue
+        scene.append({"name": name, "mesh": parts[1], "accel": parts[2], "cull": parts[3] == "cull",
+                      "rays": parts[4], "threads": keys.get("threads", "1"),
+                      "triangles": b.get("triangles"), "Mrays_per_s": float(b["Mrays_per_s"]),
+                      "build_s": b.get("build_s"), "bytes_per_triangle": b.get("bytes_per_triangle")})
+    index = {(r["mesh"], r["accel"], r["cull"], r["rays"], r["threads"]): r for r in scene}
+    one = min((r["threads"] for r in scene), key=lambda t: int(t) if t.isdigit() else 1e9, default="1")
+    speedups = []
+    for r in scene:
+        if r["threads"] != one:
+            continue
+        if r["accel"] in ("sphere", "bvh") and not r["cull"]:
+            base = index.get((r["mesh"], "none", False, r["rays"], r["threads"]))
+            if base and base["Mrays_per_s"] > 0:
+                speedups.append({"mesh": r["mesh"], "triangles": r["triangles"], "rays": r["rays"],
+                                 "what": f"{r['accel']} over none", "speedup": r["Mrays_per_s"] / base["Mrays_per_s"]})
+        if r["cull"]:
+            base = index.get((r["mesh"], r["accel"], False, r["rays"], r["threads"]))
+            if base and base["Mrays_per_s"] > 0:
+                speedups.append({"mesh": r["mesh"], "triangles": r["triangles"], "rays": r["rays"],
+                                 "what": f"culling ({r['accel']})", "speedup": r["Mrays_per_s"] / base["Mrays_per_s"]})
+    scaling = []
+    for accel in dict.fromkeys(r["accel"] for r in scene):
+        rs = sorted((r for r in scene if r["accel"] == accel and not r["cull"] and r["rays"] == "primary"
+                     and r["threads"] == one and r["triangles"]), key=lambda r: r["triangles"])
+        if not rs:
+            continue
+        n = np.array([float(r["triangles"]) for r in rs])
+        ns = np.array([1e3 / r["Mrays_per_s"] for r in rs])
+        slope = float(np.polyfit(np.log10(n), np.log10(ns), 1)[0]) if len(rs) >= 2 else None
+        scaling.append({"accel": accel, "triangles": n.tolist(), "ns_per_ray": ns.tolist(), "slope": slope,
+                        "meshes": [r["mesh"] for r in rs]})
+    return {"threads": one, "scene_rows": scene, "speedups": speedups, "scaling": scaling}
+
+
+def chart_optimisations(opt):
+    charts = []
+    sp = opt["speedups"]
+    if sp:
+        raykinds = list(dict.fromkeys(s["rays"] for s in sp))
+        groups = [("accelerator over none", [w for w in dict.fromkeys(s["what"] for s in sp) if "over none" in w]),
+                  ("backface culling", [w for w in dict.fromkeys(s["what"] for s in sp) if w.startswith("culling")])]
+        groups = [g for g in groups if g[1]]
+        fig, axes = plt.subplots(len(groups), len(raykinds), figsize=(6 * len(raykinds), 3.2 * len(groups)),
+                                 squeeze=False)
+        for gi, (gname, whats) in enumerate(groups):
+            for ax, rk in zip(axes[gi], raykinds):
+                meshes = sorted(dict.fromkeys(s["mesh"] for s in sp if s["rays"] == rk and s["what"] in whats),
+                                key=lambda m: next(s["triangles"] or 0 for s in sp if s["mesh"] == m))
+                w = 0.8 / max(1, len(whats))
+                for k, what in enumerate(whats):
+                    vals = [next((s["speedup"] for s in sp if s["mesh"] == m and s["what"] == what and s["rays"] == rk),
+                                 np.nan) for m in meshes]
+                    bars = ax.bar(np.arange(len(meshes)) + k * w, vals, w, label=what)
+                    ax.bar_label(bars, labels=[f"{v:.2g}x" if v == v else "" for v in vals], fontsize=6.5)
+                ax.axhline(1, color="k", lw=0.8)
+                ax.set_yscale("log")
+                times = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:.3g}x")
+                ax.yaxis.set_major_formatter(times)
+                ax.yaxis.set_minor_formatter(times)
+                ax.tick_params(axis="y", which="minor", labelsize=6.5)
+                ax.set_xticks(np.arange(len(meshes)) + w * (len(whats) - 1) / 2, meshes, rotation=15, fontsize=7)
+                ax.set_ylabel("speed-up (x, log)")
+                ax.set_title(f"{gname}: {rk} rays, {opt['threads']} thread(s)")
+                ax.legend(fontsize=7)
+        charts.append((svg_of(fig), "Each bar is rays per second with the optimisation divided by without it, "
+                       "per rung of the mesh ladder (smallest left): above the line it pays, below it costs."))
+    if opt["scaling"]:
+        fig, ax = plt.subplots(figsize=(6.5, 4))
+        for s in opt["scaling"]:
+            lab = s["accel"] + (f" (slope {s['slope']:.2f})" if s["slope"] is not None else "")
+            ax.plot(s["triangles"], s["ns_per_ray"], marker="o", label=lab)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("triangles in the mesh (log)")
+        ax.set_ylabel("ns per primary ray (log)")
+        ax.set_title("Cost per ray against mesh size")
+        ax.legend(fontsize=7)
+        charts.append((svg_of(fig), "Slope 1 means the cost grows with the triangle count (every triangle "
+                       "tested); near 0 means it barely grows (a BVH should be logarithmic)."))
+    return charts
+
+
+# ---------------------------------------------------------------- section 5 --
+
+
+def peers(bench):
+    out = []
+    for name, b in bench_rows(bench).items():
+        parts, _ = parse_bench_name(name)
+        if parts[:1] == ["peer"] and len(parts) >= 2 and "ratio" in b:
+            out.append({"name": name, "peer": parts[1], "ratio": float(b["ratio"])})
+    return out
+
+
+def chart_peers(ps):
+    if not ps:
+        return None
+    fig, ax = plt.subplots(figsize=(8, 0.3 * len(ps) + 1.2))
+    cmap = plt.get_cmap("tab10")
+    names = list(dict.fromkeys(p["peer"] for p in ps))
+    ys = range(len(ps))
+    ax.barh(list(ys), [p["ratio"] for p in ps], color=[cmap(names.index(p["peer"]) % 10) for p in ps])
+    ax.set_yticks(list(ys), [re.sub(r"^peer/", "", p["name"]) for p in ps], fontsize=6.5)
+    ax.axvline(1, color="k", lw=0.8)
+    ax.set_xscale("log")
+    ticks = [t for t in (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100)
+             if min(p["ratio"] for p in ps) / 2 <= t <= max(p["ratio"] for p in ps) * 2]
+    ax.set_xticks(ticks, [f"{t:g}x" for t in ticks])
+    ax.minorticks_off()
+    for y, p in zip(ys, ps):
+        ax.text(p["ratio"], y, f" {p['ratio']:.2g}x", va="center", fontsize=6.5)
+    ax.invert_yaxis()
+    ax.set_xlabel("rayaudit's rate / the peer's (log): right of 1, rayaudit is faster; left, the peer")
+    ax.set_title("rayaudit against its peers, same rays, same run")
+    return svg_of(fig)
+
+
+# ---------------------------------------------------------------- section 6 --
+
+
+def images(compare_dirs):
+    out = []
+    for d in compare_dirs:
+        for f in sorted(glob.glob(os.path.join(d, "*.json"))):
+            with open(f) as fh:
+                j = json.load(fh)
+            if "identical" not in j or "differences" not in j:
+                continue  # not a compare output (e.g. a tolerance file)
+            stem = os.path.splitext(os.path.basename(f))[0]
+            thumbs = {}
+            for kind, suffix in (("ours", "-ours.png"), ("pov", "-pov.png"), ("diff", "-diff.png")):
+                p = os.path.join(d, stem + suffix)
+                if os.path.exists(p):
+                    thumbs[kind] = p
+            causes = {(e["x"], e["y"]): e["cause"] for e in j.get("explanations", [])}
+            out.append({
+                "name": stem,
+                "scene": j.get("scene", stem),
+                "width": j["width"], "height": j["height"],
+                "identical": j["identical"],
+                "differing": j["differing"],
+                "within_tolerance": j.get("within_tolerance"),
+                "verdict": j.get("verdict", []),
+                "psnr": j.get("psnr"),
+                "differences": [{"x": e["x"], "y": e["y"], "levels": e["levels"],
+                                 "cause": causes.get((e["x"], e["y"]))} for e in j["differences"]],
+                "files": thumbs,
+            })
+    return out
+
+
+# ---------------------------------------------------------------- section 7 --
+
+
+def run(cmd):
+    try:
+        return subprocess.run(cmd, capture_output=True, text=True, timeout=20).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return ""
+
+
+def machine(ctx, audit, bench, stages):
+    cpu = ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    versions = {}
+    for label, pkg in (("Embree", "libembree-dev"), ("POV-Ray", "povray"), ("CGAL", "libcgal-dev"),
+                       ("OpenImageIO", "libopenimageio-dev"), ("Google Benchmark", "libbenchmark-dev"),
+                       ("matplotlib", "python3-matplotlib"), ("Chromium", "chromium")):
+        versions[label] = run(["dpkg-query", "-W", "-f=${Version}", pkg]) or "not installed"
+    src = ctx.get("source_dir", "")
+    commit = run(["git", "-C", src, "rev-parse", "--short=12", "HEAD"]) if src else ""
+    dirty = run(["git", "-C", src, "status", "--porcelain", "--untracked-files=no"]) if src else ""
+    ctxb = (bench or {}).get("context", {})
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "bench_context": {k: ctxb[k] for k in ("host_name", "num_cpus", "mhz_per_cpu", "library_build_type", "date")
+                          if k in ctxb},
+        "compiler": ctx["build"]["compiler"],
+        "flags": ctx["build"]["flags"],
+        "build_type": ctx["build"]["build_type"],
+        "rayaudit": ctx["build"]["version"],
+        "commit": (commit + (" (with uncommitted changes)" if dirty else "")) or "unknown",
+        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "versions": versions,
+        "seed": audit.get("seed"),
+        "rays_per_family": audit.get("rays_per_family"),
+        "stages": stages,
+    }
+
+
+# --------------------------------------------------------------------- page --
+
+CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:0 auto;max-width:1280px;padding:0 18px 40px;color:#222}
+h1{margin:18px 0 4px;font-size:24px} h2{margin-top:34px;border-bottom:2px solid #ddd;padding-bottom:3px}
+h3{margin:18px 0 4px;font-size:15px}
+.cap{color:#444;font-size:13px;margin:2px 0 14px;font-style:italic}
+.chart svg{max-width:100%;height:auto}
+table{border-collapse:collapse;font-size:12px;margin:6px 0 14px} td,th{border:1px solid #ddd;padding:3px 6px;text-align:right}
+th{background:#f4f4f4} td.l,th.l{text-align:left}
+.ok{color:#176d2c;font-weight:600} .bad{color:#b00020;font-weight:600} .warn{color:#9a6700;font-weight:600}
+.grid td{text-align:center;vertical-align:top} .grid img{image-rendering:pixelated;width:112px;height:112px;display:block;margin:auto}
+.thumbs img{max-width:160px;image-rendering:pixelated;border:1px solid #ccc}
+.keyfacts{display:flex;gap:12px;flex-wrap:wrap;margin:10px 0} .keyfacts div{background:#f6f8fa;border:1px solid #ddd;border-radius:6px;padding:8px 12px;font-size:13px}
+.notice{background:#fff8e1;border:1px solid #f0c36d;padding:8px 12px;border-radius:6px}
+dl.hdr{display:grid;grid-template-columns:max-content 1fr;gap:2px 14px;font-size:12.5px} dl.hdr dt{font-weight:600}
+"""
+
+# Runs in the browser: every image decoded and every chart drawn, or a console
+# error saying which is not (the Chromium ctest reads both).
+SELF_CHECK = """
+window.addEventListener('load', function () {
+  var bad = [], imgs = document.images, svgs = document.querySelectorAll('.chart svg');
+  for (var i = 0; i < imgs.length; i++)
+    if (!imgs[i].complete || imgs[i].naturalWidth === 0) bad.push('image ' + (imgs[i].alt || i));
+  for (var k = 0; k < svgs.length; k++) {
+    var b = svgs[k].getBBox();
+    if (!(b.width > 0 && b.height > 0) || svgs[k].querySelectorAll('path,use,text').length === 0) bad.push('chart ' + k);
+  }
+  var r = document.getElementById('selfcheck');
+  r.setAttribute('data-images', imgs.length);
+  r.setAttribute('data-charts', svgs.length);
+  r.setAttribute('data-result', bad.length ? 'FAIL' : 'ok');
+  r.textContent = bad.length ? 'self-check failed: ' + bad.join(', ')
+                             : 'self-check: ' + imgs.length + ' images and ' + svgs.length + ' charts drawn';
+  if (bad.length) console.error('report self-check failed: ' + bad.join(', '));
+});
+"""
+
+
+def chart_html(svg, caption):
+    return f'<div class="chart">{svg}</div><p class="cap">{esc(caption)}</p>'
+
+
+def page(rep, charts, methods, uris):
+    m = rep["machine"]
+    h = ['<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">',
+         '<meta name="viewport" content="width=device-width, initial-scale=1">',
+         "<title>rayaudit report</title>", f"<style>{CSS}</style>", f"<script>{SELF_CHECK}</script>",
+         "</head><body>", "<h1>rayaudit report: speed against accuracy</h1>"]
+    # ---- key facts: what a newcomer wants first.
+    sa = [e for e in rep["speed_accuracy"] if e["kind"] == "triangle"]
+    facts = []
+    timed = [e for e in sa if e["ns_per_test"] is not None]
+    if timed:
+        f = min(timed, key=lambda e: e["ns_per_test"])
+        facts.append(f"Fastest triangle test: <b>{esc(f['subject'])}</b> at {fnum(f['ns_per_test'])} ns "
+                     f"({fnum(f['wrong_pct'])}% wrong)")
+    if sa:
+        right = min(sa, key=lambda e: (e["leaks"] > 0, e["wrong_pct"], e["ns_per_test"] or 0))
+        facts.append(f"Most right: <b>{esc(right['subject'])}</b> ({fnum(right['wrong_pct'])}% wrong, "
+                     f"{right['leaks']} leaks)")
+        leakfree = [e["subject"] for e in sa if e["leaks"] == 0]
+        facts.append("Leak-free (no ray through a closed group): " +
+                     (", ".join(f"<b>{esc(s)}</b>" for s in leakfree) if leakfree else "<b>none</b>"))
+    if rep["images"]:
+        bad = [i["name"] for i in rep["images"] if i["within_tolerance"] is False]
+        facts.append("POV-Ray comparisons: " + (f'<span class="bad">{len(bad)} beyond tolerance</span>' if bad
+                                                 else f'<span class="ok">all {len(rep["images"])} within tolerance</span>'))
+    h.append('<div class="keyfacts">' + "".join(f"<div>{f}</div>" for f in facts) + "</div>")
+    h.append('<p id="selfcheck" data-result="pending">self-check: pending</p>')
+
+    # ---- 7 header (first on the page: what the figures rest on).
+    h.append("<h2>The run</h2>")
+    h.append('<p class="cap">What these figures were measured on; every ratio below is from this one run.</p><dl class="hdr">')
+    rows = [("CPU", f"{m['cpu']} ({m['cores']} cores)"), ("Compiler", m["compiler"]),
+            ("Flags", f"{m['flags']} ({m['build_type']})"), ("rayaudit", f"{m['rayaudit']}, commit {m['commit']}"),
+            ("Date", m["date"]),
+            ("Libraries", ", ".join(f"{k} {v}" for k, v in m["versions"].items())),
+            ("Audit", f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method x precision")]
+    if m["bench_context"]:
+        names = {"host_name": "host", "num_cpus": "CPUs", "mhz_per_cpu": "MHz",
+                 "library_build_type": "Google Benchmark library built as", "date": "run at"}
+        rows.append(("Benchmark", ", ".join(f"{names.get(k, k)} {v}" for k, v in m["bench_context"].items())))
+    if m["stages"]:
+        rows.append(("Stages", ", ".join(f"{esc(s['stage'])} {s['seconds']:.0f} s" for s in m["stages"])))
+    for k, v in rows:
+        h.append(f"<dt>{esc(k)}</dt><dd>{esc(v)}</dd>")
+    h.append("</dl>")
+
+    # ---- 1
+    h.append("<h2>1. Speed against accuracy</h2>")
+    if not rep["have_bench"]:
+        h.append('<p class="notice">No benchmark given: speeds are missing (run <code>rayaudit bench --quick '
+                 '--json B.json</code> and pass <code>--bench B.json</code>).</p>')
+    for svg, cap in charts["speed_accuracy"]:
+        h.append(chart_html(svg, cap))
+    h.append('<table><tr><th class="l">method/precision</th><th>ns per test</th><th>wrong %</th><th>leaks</th>'
+             '<th>leaks per million</th><th>tests</th><th class="l">breaks worst at (family@sweep)</th>'
+             '<th class="l">source</th></tr>')
+    for e in rep["speed_accuracy"]:
+        src = methods.by_name.get(e["method"], {}).get("source", "")
+        w = e.get("worst")
+        worst = f"{w['family']}@{w['sweep']} ({100 * w['badness']:.3g}% bad)" if w else "nowhere"
+        h.append(f'<tr><td class="l">{esc(methods.label(e["method"]))}/{esc(e["precision"])}</td>'
+                 f"<td>{fnum(e['ns_per_test'])}</td><td>{fnum(e['wrong_pct'])}</td><td>{e['leaks']}</td>"
+                 f"<td>{fnum(e['leaks_per_million'])}</td><td>{e['tests']}</td>"
+                 f"<td class=\"l\">{esc(worst)}</td><td class=\"l\">{esc(src)}</td></tr>")
+    h.append("</table>")
+
+    # ---- 2
+    h.append("<h2>2. Stability: where each method breaks</h2>")
+    h.append('<p class="cap">Every audit family with a sweep. y axes are linear near 0 and logarithmic above, '
+             "so a single wrong answer shows.</p>")
+    for family, svg, cap in charts["stability"]:
+        h.append(f"<h3>{esc(family)}</h3>" + chart_html(svg, cap))
+
+    # ---- 3
+    h.append("<h2>3. Crack maps</h2>")
+    if not rep["crack_maps"]:
+        h.append('<p class="notice">No crack maps given (<code>rayaudit crack-maps -o DIR</code>, then '
+                 "<code>--crack-maps DIR</code>).</p>")
+    else:
+        h.append(chart_html(charts["crack_leaks"], "Leaking pixels (rays through the closed surface) of each method "
+                            "in float as the mesh moves away from the origin, where every ray starts: 0 is right."))
+        cm = rep["crack_maps"]
+        for mesh in dict.fromkeys(c["mesh"] for c in cm):
+            info = next((x for x in rep["crack_meshes"] if x["name"] == mesh), {})
+            h.append(f"<h3>{esc(mesh)}: {esc(info.get('source', ''))}, {info.get('triangles', '?')} triangles</h3>")
+            offsets = sorted(dict.fromkeys(c["offset"] for c in cm if c["mesh"] == mesh))
+            h.append('<table class="grid"><tr><th class="l">method (float)</th>' +
+                     "".join(f"<th>offset {offset_label(o)}</th>" for o in offsets) + "</tr>")
+            for method in dict.fromkeys(c["method"] for c in cm if c["mesh"] == mesh):
+                h.append(f'<tr><td class="l">{esc(methods.label(method))}</td>')
+                for o in offsets:
+                    c = next((c for c in cm if c["mesh"] == mesh and c["method"] == method and c["offset"] == o), None)
+                    if not c:
+                        h.append("<td>-</td>")
+                        continue
+                    cls = "ok" if c["leaks"] == 0 else "bad"
+                    extra = f", {c['false_hits']} false" if c["false_hits"] else ""
+                    h.append(f'<td><img alt="{esc(mesh)} {esc(method)} {fnum(o)}" src="{uris[c["image"]]}">'
+                             f'<span class="{cls}">{c["leaks"]} leaks</span>{esc(extra)}</td>')
+                h.append("</tr>")
+            h.append("</table>")
+        h.append(f'<p class="cap">{esc(rep["crack_legend"])}. Each map: the mesh centred at (o, o, o), '
+                 "seen from the origin once o is beyond 6.5 (every ray then starts at the origin, as in a large "
+                 "world), one ray per pixel, everything in float; the oracle judges each float ray exactly.</p>")
+
+    # ---- 4
+    h.append("<h2>4. Optimisations</h2>")
+    if not rep["have_bench"]:
+        h.append('<p class="notice">No benchmark given: the optimisations are not measured here.</p>')
+    elif not charts["optimisations"]:
+        h.append('<p class="notice">The benchmark has no scene/ rows.</p>')
+    for svg, cap in charts["optimisations"]:
+        h.append(chart_html(svg, cap))
+
+    # ---- 5
+    h.append("<h2>5. Peers</h2>")
+    if not rep["have_bench"]:
+        h.append('<p class="notice">No benchmark given: no peer ratios.</p>')
+    elif charts["peers"]:
+        h.append(chart_html(charts["peers"], "Each bar: rayaudit's rate divided by the peer's on the same input in "
+                            "the same run (medians). Right of the line rayaudit is faster."))
+    else:
+        h.append('<p class="notice">The benchmark has no peer/ rows.</p>')
+
+    # ---- 6
+    h.append("<h2>6. Images: rayaudit against POV-Ray 3.7</h2>")
+    if not rep["images"]:
+        h.append('<p class="notice">No comparisons given (<code>--compare DIR</code>).</p>')
+    else:
+        h.append('<p class="cap">Each scene as we render it, as POV-Ray 3.7 renders it, and their difference '
+                 "(false colour; black is equal; each differing pixel ringed in yellow). Every differing pixel is "
+                 "listed with the cause --explain found.</p>")
+        h.append('<table class="thumbs"><tr><th class="l">scene</th><th>ours</th><th>POV-Ray</th><th>difference</th>'
+                 '<th class="l">verdict</th></tr>')
+        for im in rep["images"]:
+            cells = []
+            for kind in ("ours", "pov", "diff"):
+                p = im["files"].get(kind)
+                cells.append(f'<td><img alt="{esc(im["name"])} {kind}" src="{uris[p]}"></td>' if p else "<td>-</td>")
+            status = ('<span class="ok">identical</span>' if im["identical"] else
+                      (f'<span class="ok">{im["differing"]} pixel(s) differ, within tolerance</span>'
+                       if im["within_tolerance"] else f'<span class="bad">{im["differing"]} pixel(s) differ</span>'))
+            diffs = "".join(f"<li>({d['x']}, {d['y']}) {d['levels']} level(s): "
+                            f"{esc(d['cause'] if d['cause'] else ('none of the known causes' if d['cause'] == '' else 'not explained (run with --explain)'))}</li>"
+                            for d in im["differences"][:12])
+            more = f"<li>... {len(im['differences']) - 12} more</li>" if len(im["differences"]) > 12 else ""
+            h.append(f'<tr><td class="l">{esc(im["name"])}<br><small>{im["width"]}x{im["height"]}</small></td>'
+                     + "".join(cells) + f'<td class="l">{status}<ul>{diffs}{more}</ul></td></tr>')
+        h.append("</table>")
+    h.append("<h3>Golden images</h3>")
+    if rep["golden"] is None:
+        h.append('<p class="notice">No golden check given (<code>--golden FILE</code>).</p>')
+    else:
+        h.append('<table><tr><th class="l">scene</th><th class="l">status</th><th class="l">detail</th></tr>')
+        for g in rep["golden"]:
+            cls = {"ok": "ok", "fail": "bad"}.get(g["status"], "warn")
+            h.append(f'<tr><td class="l">{esc(g["name"])}</td><td class="l {cls}">{esc(g["status"])}</td>'
+                     f'<td class="l">{esc(g["message"])}</td></tr>')
+        h.append("</table>")
+    h.append("</body></html>")
+    return "\n".join(h)
+
+
+def finite(v):
+    """JSON has no NaN or infinity (Google Benchmark writes them): null instead."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, dict):
+        return {k: finite(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [finite(x) for x in v]
+    return v
+
+
+def main():
+    with open(sys.argv[1]) as f:
+        ctx = json.load(f)
+    methods = Methods(ctx["methods"])
+    with open(ctx["audit"]) as f:
+        audit = json.load(f)
+    bench = None
+    if ctx.get("bench"):
+        with open(ctx["bench"]) as f:
+            bench = json.load(f)
+    cm, cm_dir = None, ctx.get("crack_maps")
+    if cm_dir:
+        with open(os.path.join(cm_dir, "crack_maps.json")) as f:
+            cm = json.load(f)
+    golden = None
+    if ctx.get("golden"):
+        with open(ctx["golden"]) as f:
+            golden = json.load(f)["scenes"]
+    stages = []
+    if ctx.get("stages"):
+        with open(ctx["stages"]) as f:
+            for line in f:
+                if line.strip():
+                    name, secs = line.rstrip("\n").rsplit("\t", 1)
+                    stages.append({"stage": name, "seconds": float(secs)})
+
+    rep = {
+        "have_bench": bench is not None,
+        "speed_accuracy": speed_accuracy(audit, bench, methods),
+        "stability": stability(audit),
+        "crack_maps": crack_maps(cm, cm_dir) if cm else [],
+        "crack_meshes": cm["meshes"] if cm else [],
+        "crack_legend": cm["legend"] if cm else "",
+        "optimisations": optimisations(bench) if bench else None,
+        "peers": peers(bench) if bench else None,
+        "images": images(ctx.get("compare", [])),
+        "golden": golden,
+        "machine": machine(ctx, audit, bench, stages),
+    }
+    charts = {
+        "speed_accuracy": chart_speed_accuracy(rep["speed_accuracy"], methods, bench is not None),
+        "stability": chart_stability(rep["stability"], methods),
+        "crack_leaks": chart_crack_leaks(rep["crack_maps"], methods) if rep["crack_maps"] else None,
+        "optimisations": chart_optimisations(rep["optimisations"]) if bench else [],
+        "peers": chart_peers(rep["peers"]) if bench else None,
+    }
+    uris = {}
+    for c in rep["crack_maps"]:
+        uris[c["image"]] = data_uri(c["image"])
+    for im in rep["images"]:
+        for kind, p in im["files"].items():
+            marks = [(d["x"], d["y"]) for d in im["differences"]] if kind == "diff" else ()
+            uris[p] = data_uri(p, marks=marks[:50])
+    text = page(rep, charts, methods, uris)
+    out = ctx["out_dir"]
+    with open(os.path.join(out, "index.html"), "w") as f:
+        f.write(text)
+    with open(os.path.join(out, "report.json"), "w") as f:
+        json.dump(finite(rep), f, indent=1, allow_nan=False, default=str)
+        f.write("\n")
+
+
+if __name__ == "__main__":
+    main()
