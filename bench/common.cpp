@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <numeric>
 
 #include "bench.h"
 #include "camera.h"
@@ -26,7 +27,7 @@ std::vector<int> thread_counts() {
 }
 
 int repetitions() { return config().quick ? 3 : 5; }
-double min_time() { return config().quick ? 0.005 : 0.03; }
+double min_time() { return config().quick ? 0.005 : 0.02; }
 
 double thread_cpu_seconds() {
   timespec t{};
@@ -193,9 +194,11 @@ BuiltTracer& our_tracer(const Rung& r, ra::Accel accel, bool cull) {
 
 std::vector<ra::Rayd> subset(const std::vector<ra::Rayd>& rays, std::size_t max_rays) {
   if (rays.size() <= max_rays) return rays;
-  // A stride prime to the image width spreads the subset over rows and columns.
+  // A stride prime to the image width moves the sampled column from row to
+  // row, so the subset spreads over rows and columns alike (a multiple of
+  // the width would sample one column only).
   std::size_t stride = (rays.size() + max_rays - 1) / max_rays;
-  while (std::size_t(kWidth) % stride == 0 && stride > 1) ++stride;
+  while (std::gcd(stride, std::size_t(kWidth)) != 1) ++stride;
   std::vector<ra::Rayd> out;
   for (std::size_t i = 0; i < rays.size() && out.size() < max_rays; i += stride) out.push_back(rays[i]);
   return out;
