@@ -160,6 +160,13 @@ TEST(BenchCli, MissingCorpusFileIsNamed) {
   fs::remove_all(empty);
 }
 
+// A peer that is not installed is an error before anything runs, not a skip.
+TEST(BenchCli, MissingPovRayIsAnError) {
+  if (!corpus_present()) GTEST_SKIP() << "mesh corpus not fetched (ci/fetch-corpus.sh)";
+  expect_refused("--filter peer/pov/", "RAYAUDIT_POVRAY=/nonexistent/povray is not an executable program",
+                 "RAYAUDIT_POVRAY=/nonexistent/povray");
+}
+
 TEST(BenchCli, OtherArgumentsAreRefused) {
   expect_refused("--bogus", "unknown argument \"--bogus\"");
   expect_refused("--benchmark_out=x.json", "use --json OUT");
