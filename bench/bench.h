@@ -104,7 +104,7 @@ struct BuiltTracer {
 };
 BuiltTracer& our_tracer(const Rung& r, ra::Accel accel, bool cull);
 
-// Every `stride`-th ray, at most `max_rays` of them, spread over the set.
+// At most `max_rays` of the rays, evenly spread over the set (all if fewer).
 std::vector<ra::Rayd> subset(const std::vector<ra::Rayd>& rays, std::size_t max_rays);
 
 // Our closest hits (primary) or any hits (shadow) over `rays` on `threads`

@@ -160,6 +160,24 @@ TEST(BenchCli, MissingCorpusFileIsNamed) {
   fs::remove_all(empty);
 }
 
+// Killed mid-run (timeout sends SIGTERM after 4 s of a ~30 s run): neither
+// the JSON nor its temporary is left behind.
+TEST(BenchCli, InterruptedRunWritesNothing) {
+  const fs::path out = temp_json("interrupted.json");
+  const auto r = run_rayaudit("bench --quick --json " + out.string() + " --filter kernel/", "timeout -s TERM 4");
+  EXPECT_EQ(r.code, 124) << r.all;  // timeout's code: the run was still going
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(out.parent_path()))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+}
+
+// A peer that is not installed is an error before anything runs, not a skip.
+TEST(BenchCli, MissingPovRayIsAnError) {
+  if (!corpus_present()) GTEST_SKIP() << "mesh corpus not fetched (ci/fetch-corpus.sh)";
+  expect_refused("--filter peer/pov/", "RAYAUDIT_POVRAY=/nonexistent/povray is not an executable program",
+                 "RAYAUDIT_POVRAY=/nonexistent/povray");
+}
+
 TEST(BenchCli, OtherArgumentsAreRefused) {
   expect_refused("--bogus", "unknown argument \"--bogus\"");
   expect_refused("--benchmark_out=x.json", "use --json OUT");

@@ -5,6 +5,7 @@
 //
 //   rayaudit-bench [--quick] [--json OUT] [--threads N] [--filter REGEX] [--benchmark_*...]
 #include <malloc.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -177,6 +178,14 @@ fs::path make_temp_beside(const fs::path& out) {
   return tmp;
 }
 
+// Ctrl-C or a kill during the run removes the temporary JSON too (the
+// handler may only call async-signal-safe functions: unlink, _exit).
+char g_tmp_path[4096];
+void remove_tmp_and_exit(int sig) {
+  if (g_tmp_path[0]) unlink(g_tmp_path);
+  _exit(128 + sig);
+}
+
 // The console table as usual; remembers whether a row failed.
 class Reporter : public benchmark::ConsoleReporter {
  public:
@@ -216,6 +225,12 @@ int run(int argc, char** argv) {
       if (!p.empty()) fs::remove(p, ec);
     }
   } guard{tmp};
+  if (!tmp.empty() && tmp.native().size() < sizeof g_tmp_path) {
+    std::strcpy(g_tmp_path, tmp.c_str());
+    signal(SIGINT, remove_tmp_and_exit);
+    signal(SIGTERM, remove_tmp_and_exit);
+    signal(SIGHUP, remove_tmp_and_exit);
+  }
 
   std::vector<std::string> gb_args = {argv[0], "--benchmark_repetitions=" + std::to_string(rb::repetitions()),
                                       "--benchmark_min_time=" + std::to_string(rb::min_time()),

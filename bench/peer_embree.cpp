@@ -157,7 +157,7 @@ void bm_build(benchmark::State& state, const Rung* rung, bool robust, int thread
 
 void bm_trace(benchmark::State& state, const Rung* rung, bool robust, bool shadow, int threads) {
   RungRays& rr = rung_rays(*rung);
-  // --quick: an evenly spread quarter-million of the rays.
+  // --quick: an evenly spread subset, at most 2^18 rays.
   const std::vector<ra::Rayd> rays =
       subset(shadow ? rr.shadow : rr.primary, config().quick ? std::size_t(1) << 18 : std::size_t(kWidth) * kHeight);
   const ra::Tracer& ours = *our_tracer(*rung, ra::Accel::bvh, false).tracer;

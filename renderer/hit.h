@@ -11,7 +11,7 @@ namespace ra {
 // alignas(16): an optional<TriangleHit<float>> would otherwise be 16 bytes,
 // which GCC returns in two registers built and reread through the stack, a
 // store-forwarding stall on every call that made every float method about
-// 1.5x slower than its double twin (bench/triangle_methods_bench: moller
+// 1.5x slower than its double twin (`rayaudit bench`, kernel/ rows: moller
 // 10.4 ns float vs 6.9 double before, 6.6 vs 7.0 after). Aligned, it is
 // returned in memory as the double one is.
 template <class T>

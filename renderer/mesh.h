@@ -131,7 +131,7 @@ struct ObjOptions {
   int threads = 1;
   // Files smaller than this are parsed serially whatever `threads` says:
   // the parallel scheme's extra passes (count, then fix-ups) cost more than
-  // a second core saves on small files (obj_parse_bench on 2 cores: the
+  // a second core saves on small files (`rayaudit bench` obj/ rows, 2 cores: the
   // 2.4 MB bunny took 4.1 ms on 2 threads against 3.7 ms on one).
   std::size_t parallel_min_bytes = std::size_t(8) << 20;
 };

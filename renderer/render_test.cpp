@@ -52,6 +52,22 @@ TEST(Intersect, SphereBehindTheOriginIsMissed) {
   EXPECT_FALSE(tr.intersect({{0, 0, 5}, {0, 0, 1}}));
 }
 
+// occluded() asks only "anything in the window?": the unit sphere spans
+// t in [4, 6] along this ray, so a window ending at 3.9 is clear, one
+// ending at 4.1 or starting inside (at 5) is not; in float too.
+TEST(Occluded, HonoursTheRayWindowInBothPrecisions) {
+  Scene s = parse(kUnitSphere);
+  for (bool dbl : {true, false}) {
+    RenderOptions o = opts();
+    o.use_double = dbl;
+    Tracer tr(s, o);
+    EXPECT_FALSE(tr.occluded({{0, 0, 5}, {0, 0, -1}, 0.0, 3.9})) << dbl;
+    EXPECT_TRUE(tr.occluded({{0, 0, 5}, {0, 0, -1}, 0.0, 4.1})) << dbl;
+    EXPECT_TRUE(tr.occluded({{0, 0, 5}, {0, 0, -1}, 5.0, 100.0})) << dbl;
+    EXPECT_FALSE(tr.occluded({{0, 0, 5}, {0, 0, 1}, 0.0, 100.0})) << dbl;
+  }
+}
+
 TEST(Intersect, PlaneFromBothSidesAndParallel) {
   Scene s = parse(R"({"lights": [], "objects": [{"plane": {"normal": [0,2,0], "offset": 2}}]})");
   // normal [0,2,0] with offset 2 is the plane y = 1 (POV scales both).
