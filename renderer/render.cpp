@@ -13,9 +13,10 @@
 #include <type_traits>
 
 #include "bump.h"
-#include "bvh.h"
+#include "accel/bvh.h"
 #include "camera.h"
 #include "errors.h"
+#include "methods/moller_simd.h"
 #include "pov_mesh.h"
 #include "registry.h"
 #include "texture.h"
@@ -45,13 +46,15 @@ constexpr double kMinCosIncidence = 1e-10;
 // A mesh ready for tracing at precision T: each triangle's prepared bytes
 // for the chosen method, its unit geometric normal, and the bounding sphere
 // of document 002's optimisation. With --accel bvh the prepared bytes are
-// stored in the BVH's slot order (bvh.order maps a slot to its triangle).
+// stored in the BVH's slot order (bvh.order maps a slot to its triangle), and
+// for moller its leaves also as 4-lane blocks (methods/moller_simd.h).
 template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
   std::size_t stride = 0;
   std::vector<unsigned char> pre;  // per triangle, or per BVH slot
   Bvh bvh;                         // --accel bvh only
+  std::vector<moller_simd::Tri4<T>> tri4;  // per BVH leaf, moller only
   std::vector<Vec3d> gnormal;        // per triangle, (B-A)x(C-A) normalised
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
@@ -186,37 +189,26 @@ struct Tracer::Impl {
       hi[i] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
     }
     const double size = std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
-    m.bvh = Bvh::build(lo, hi, 1e-5 * size);
-    std::vector<unsigned char> pre(m.pre.size());
-    for (std::size_t s = 0; s < n; ++s)
-      std::memcpy(pre.data() + s * m.stride, m.pre.data() + std::size_t(m.bvh.order[s]) * m.stride, m.stride);
+    m.bvh = Bvh::build(lo, hi, 1e-5 * size, opt.threads);
+    const std::size_t slots = m.bvh.order.size();
+    std::vector<unsigned char> pre(slots * m.stride, 0);
+    for (std::size_t s = 0; s < slots; ++s)
+      if (m.bvh.order[s] != Bvh::kNoTriangle)
+        std::memcpy(pre.data() + s * m.stride, m.pre.data() + std::size_t(m.bvh.order[s]) * m.stride, m.stride);
     m.pre = std::move(pre);
-  }
-
-  // Visits the BVH leaves the ray's window meets, near child first; `leaf`
-  // gets each slot and returns true to stop. `tmax` is re-read at every node
-  // (closest-hit shrinks it).
-  template <class T, class Leaf>
-  static void traverse(const Bvh& bvh, const Ray<T>& r, const T& tmax, Leaf&& leaf) {
-    if (bvh.nodes.empty()) return;
-    const Vec3d o(r.o), d(r.d);
-    const Vec3d inv{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
-    std::uint32_t stack[Bvh::kMaxDepth + 2];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const std::uint32_t ni = stack[--top];
-      const BvhNode& node = bvh.nodes[ni];
-      if (!ray_meets_box(node, o, inv, d, double(r.tmin), double(tmax))) continue;
-      if (node.count > 0) {
-        for (std::uint32_t s = node.index; s < node.index + node.count; ++s)
-          if (leaf(s)) return;
-        continue;
+    // moller has a 4-lane form that answers bit for bit as the scalar one.
+    if (tri_method->name == "moller") {
+      m.tri4.assign(slots / 4, moller_simd::Tri4<T>{});
+      for (std::size_t s = 0; s < slots; ++s) {
+        if (m.bvh.order[s] == Bvh::kNoTriangle) continue;
+        const auto& tri = set.triangles[m.bvh.order[s]];
+        auto& blk = m.tri4[s / 4];
+        for (int a = 0; a < 3; ++a) {
+          blk.a[a][s % 4] = T(set.positions[tri.v[0]][a]);
+          blk.b[a][s % 4] = T(set.positions[tri.v[1]][a]);
+          blk.c[a][s % 4] = T(set.positions[tri.v[2]][a]);
+        }
       }
-      std::uint32_t near_child = ni + 1, far_child = node.index;
-      if (d[node.axis] < 0) std::swap(near_child, far_child);
-      stack[top++] = far_child;
-      stack[top++] = near_child;
     }
   }
 
@@ -256,9 +248,22 @@ struct Tracer::Impl {
           const auto& m = meshes<T>()[mesh_index[oi]];
           const auto& k = tri_method->triangle<T>();
           if (opt.accel == Accel::bvh) {
-            traverse(m.bvh, window, window.tmax, [&](std::uint32_t slot) {
-              if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
-                consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
+            if (!m.tri4.empty()) {
+              traverse(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) {
+                moller_simd::Hit4<T> h;
+                moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
+                for (int hits = h.hits; hits; hits &= hits - 1) {
+                  const int l = __builtin_ctz(unsigned(hits));
+                  consider(double(h.t[l]), int(oi), int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
+                }
+                return false;
+              });
+              break;
+            }
+            traverse(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) {
+              for (std::uint32_t slot = first; slot < first + count; ++slot)
+                if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
+                  consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
               return false;
             });
             break;
@@ -296,9 +301,19 @@ struct Tracer::Impl {
           const auto& k = tri_method->triangle<T>();
           if (opt.accel == Accel::bvh) {
             bool hit = false;
-            traverse(m.bvh, r, r.tmax, [&](std::uint32_t slot) {
-              return hit = k.any_pre(r, m.pre.data() + slot * m.stride, m.cull);
-            });
+            if (!m.tri4.empty()) {
+              traverse(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) {
+                moller_simd::Hit4<T> h;
+                moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
+                return hit = h.hits != 0;
+              });
+            } else {
+              traverse(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) {
+                for (std::uint32_t slot = first; slot < first + count; ++slot)
+                  if (k.any_pre(r, m.pre.data() + slot * m.stride, m.cull)) return hit = true;
+                return false;
+              });
+            }
             if (hit) return true;
             break;
           }
@@ -525,6 +540,9 @@ Tracer::~Tracer() = default;
 
 Color Tracer::trace(const Ray<double>& ray) const { return impl_->trace(ray, 1, 1.0); }
 std::optional<SceneHit> Tracer::intersect(const Ray<double>& ray) const { return impl_->intersect(ray); }
+bool Tracer::occluded(const Ray<double>& ray) const {
+  return impl_->opt.use_double ? impl_->occluded<double>(ray) : impl_->occluded<float>(static_cast<Ray<float>>(ray));
+}
 Color Tracer::pixel(int i, int j) const { return impl_->pixel(i, j); }
 std::optional<Tracer::ShadingPoint> Tracer::shading_point(const Ray<double>& ray) const {
   const auto hit = impl_->intersect(ray);

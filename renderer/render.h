@@ -55,6 +55,9 @@ class Tracer {
   Color trace(const Ray<double>& ray) const;
   // The closest hit of a ray, if any (the ray's own window applies).
   std::optional<SceneHit> intersect(const Ray<double>& ray) const;
+  // Is anything in the ray's window? (what shadow rays ask), in the chosen
+  // precision.
+  bool occluded(const Ray<double>& ray) const;
   // The surface where a ray first hits: point, geometric normal and the
   // shading normal as lighting sees it before the face-forward flip
   // (interpolated for smooth meshes, with document 002's bumps applied), and

@@ -1,0 +1,207 @@
+// A 4-wide bounding volume hierarchy over one mesh's triangles, the modern
+// reference next to document 002's optimisations (backface culling, the
+// bounding sphere in bounding_sphere.h). Sources: binned SAH (Wald 2007, "On
+// fast construction of SAH-based BVHs"), collapsed to 4 children per node
+// (Dammertz et al. 2008, "Shallow bounding volume hierarchies"; Embree's
+// BVH4), and boxes tested 4 at a time in float with the rounding made
+// conservative (Ize 2013, "Robust BVH Ray Traversal"; Embree's robust mode).
+//
+// Guarantee: every leaf whose padded box the exact ray segment [tmin, tmax]
+// meets is visited, so a hit the triangle kernel reports (inside its triangle
+// up to the kernel's rounding, which the padding covers) is never missed.
+// Visit order never matters for the answer: the tracer breaks ties on t by
+// object and triangle index, so the closest hit is the same as a loop over
+// all triangles (the --accel identity tests).
+//
+// Why the float test is conservative for double (or float) rays:
+//  - boxes are rounded outward to float and padded by `pad` (the tracer uses
+//    1e-5 of the mesh's size and distance from the origin);
+//  - the ray origin is rounded to float. Where |o_a| <= 2 * size the error is
+//    <= 2^-24 * 2 size, far below the padding; farther out every box plane
+//    is at least |o_a| / 2 away, so the error is at most 2^-23 relative to
+//    (plane - o_a), i.e. relative in t;
+//  - 1/d rounded to float, the subtraction and the product add 3 roundings:
+//    all of it is relative to t, covered by widening [tnear, tfar] by
+//    kRelSlack = 2^-20 (16 float ulps) of their magnitudes;
+//  - d_a = 0 gives 1/d_a = +-inf: (plane - o_a) * inf is +-inf, or NaN when
+//    o_a lies exactly on the plane, which the min/max below ignore (the slab
+//    then constrains nothing), as Williams et al. 2005 intend;
+//  - a ray float cannot hold (|o| > 1e30, |1/d| below float's normal range
+//    or above it while d != 0) visits every leaf instead.
+#pragma once
+#include <immintrin.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "../vec.h"
+
+namespace ra {
+
+// Four children's boxes, structure of arrays: lo[axis][child]. 128 bytes,
+// two cache lines, aligned.
+struct alignas(64) BvhNode4 {
+  float lo[3][4];
+  float hi[3][4];
+  std::uint32_t child[4];  // Bvh::kEmpty, a leaf (Bvh::kLeaf | ...) or a node index
+};
+
+struct Bvh {
+  static constexpr int kBins = 16;
+  static constexpr int kMaxLeaf = 4;       // triangles per leaf; every leaf owns 4 slots
+  static constexpr int kMaxDepth = 128;    // binary depth bound (build); 4-wide depth is below it
+  static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
+  static constexpr std::uint32_t kLeaf = 0x80000000u;      // child word: leaf flag
+  static constexpr std::uint32_t kNoTriangle = 0xFFFFFFFFu;  // order[] of an unused slot
+  static constexpr float kRelSlack = 1.0f / (1 << 20);
+
+  std::vector<BvhNode4> nodes;       // nodes[0] is the root (empty for an empty mesh)
+  std::vector<std::uint32_t> order;  // slot -> triangle; leaf k's slots are 4k .. 4k + count - 1
+
+  static bool is_leaf(std::uint32_t c) { return c != kEmpty && (c & kLeaf); }
+  // A leaf's first slot (a multiple of 4) and its number of triangles (1..4).
+  static std::uint32_t leaf_first(std::uint32_t c) { return (c & 0x1FFFFFFFu) << 2; }
+  static std::uint32_t leaf_count(std::uint32_t c) { return ((c >> 29) & 3u) + 1; }
+  static std::uint32_t make_leaf(std::uint32_t leaf_index, std::uint32_t count) {
+    return kLeaf | ((count - 1) << 29) | leaf_index;
+  }
+
+  // Builds over triangles given by their boxes; `pad` widens every box.
+  // Uses up to `threads` threads (0: all cores); the tree does not depend
+  // on the thread count.
+  static Bvh build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, double pad, int threads = 0);
+};
+
+namespace bvh_detail {
+
+typedef float v4f __attribute__((vector_size(16)));
+typedef int v4i __attribute__((vector_size(16)));
+
+inline v4f load4(const float* p) {
+  v4f v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+inline v4f splat(float x) { return v4f{x, x, x, x}; }
+inline v4f vabs(v4f x) {
+  return (v4f)((v4i)x & v4i{0x7FFFFFFF, 0x7FFFFFFF, 0x7FFFFFFF, 0x7FFFFFFF});
+}
+
+// float rounded towards -inf / +inf from double.
+inline float round_down(double x) {
+  float f = float(x);
+  if (double(f) > x) f = std::nextafter(f, -INFINITY);
+  return f;
+}
+inline float round_up(double x) {
+  float f = float(x);
+  if (double(f) < x) f = std::nextafter(f, INFINITY);
+  return f;
+}
+
+// The ray as the box test sees it.
+struct BoxRay {
+  v4f o[3], inv[3];
+  int near_hi[3];  // 1 when d_a < 0 (or -0): the near plane is hi
+  v4f tmin;
+  bool exact = true;  // false: float cannot hold this ray; visit every leaf
+};
+
+inline BoxRay box_ray(const Vec3d& o, const Vec3d& d, double tmin) {
+  BoxRay b;
+  for (int a = 0; a < 3; ++a) {
+    const double inv = 1.0 / d[a];
+    const float of = float(o[a]), invf = float(inv);
+    if (!(std::abs(of) <= 1e30f)) b.exact = false;
+    if (d[a] != 0 && !(std::abs(invf) >= std::numeric_limits<float>::min() && std::isfinite(invf)))
+      b.exact = false;
+    b.o[a] = splat(of);
+    b.inv[a] = splat(invf);
+    b.near_hi[a] = std::signbit(invf) ? 1 : 0;
+  }
+  b.tmin = splat(round_down(tmin));
+  return b;
+}
+
+// Bit i set: child i's box meets [tmin, tmax]; tnear gets each box's
+// lower bound of the entry t (for ordering and pruning).
+inline int meet4(const BvhNode4& n, const BoxRay& r, float tmax, v4f& tnear) {
+  v4f tn = r.tmin, tf = splat(tmax);
+  for (int a = 0; a < 3; ++a) {
+    const v4f nearp = load4(r.near_hi[a] ? n.hi[a] : n.lo[a]);
+    const v4f farp = load4(r.near_hi[a] ? n.lo[a] : n.hi[a]);
+    const v4f t0 = (nearp - r.o[a]) * r.inv[a];
+    const v4f t1 = (farp - r.o[a]) * r.inv[a];
+    // NaN (origin exactly on the plane of a d_a = 0 slab) keeps the old bound.
+    tn = t0 > tn ? t0 : tn;
+    tf = t1 < tf ? t1 : tf;
+  }
+  const v4f slack = splat(Bvh::kRelSlack);
+  tnear = tn - vabs(tn) * slack;
+  const v4f far_up = tf + vabs(tf) * slack;
+  return _mm_movemask_ps((__m128)(tnear <= far_up));
+}
+
+}  // namespace bvh_detail
+
+// Visits the leaves whose boxes the ray's window meets, nearest box first;
+// `leaf(first_slot, count)` returns true to stop. `tmax` is re-read after
+// every leaf (closest-hit shrinks it), and boxes entered beyond it are
+// skipped.
+template <class T, class Leaf>
+void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax, Leaf&& leaf) {
+  using namespace bvh_detail;
+  if (bvh.nodes.empty()) return;
+  const BoxRay r = box_ray(Vec3d(o), Vec3d(d), double(tmin));
+  struct Entry {
+    std::uint32_t node;
+    float tnear;
+  };
+  Entry stack[3 * Bvh::kMaxDepth + 4];
+  int top = 0;
+  float tmax_f = round_up(double(tmax));
+  stack[top++] = {0, -INFINITY};
+  while (top > 0) {
+    const Entry e = stack[--top];
+    if (e.tnear > tmax_f) continue;
+    const BvhNode4& n = bvh.nodes[e.node];
+    v4f tn;
+    int mask;
+    if (r.exact) {
+      mask = meet4(n, r, tmax_f, tn);
+    } else {
+      mask = 0;
+      for (int i = 0; i < 4; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
+      tn = splat(-INFINITY);
+    }
+    if (!mask) continue;
+    // Children hit, sorted far to near so the nearest is pushed last.
+    Entry hit[4];
+    int k = 0;
+    for (; mask; mask &= mask - 1) {
+      const int i = __builtin_ctz(unsigned(mask));
+      Entry c{n.child[i], tn[i]};
+      int j = k++;
+      while (j > 0 && hit[j - 1].tnear < c.tnear) {
+        hit[j] = hit[j - 1];
+        --j;
+      }
+      hit[j] = c;
+    }
+    for (int i = 0; i < k; ++i) {
+      if (Bvh::is_leaf(hit[i].node)) continue;
+      stack[top++] = hit[i];
+    }
+    // Leaves now, nearest first (they were sorted far to near).
+    for (int i = k - 1; i >= 0; --i) {
+      if (!Bvh::is_leaf(hit[i].node)) continue;
+      if (hit[i].tnear > tmax_f) continue;
+      if (leaf(Bvh::leaf_first(hit[i].node), Bvh::leaf_count(hit[i].node))) return;
+      tmax_f = round_up(double(tmax));
+    }
+  }
+}
+
+}  // namespace ra
