@@ -554,8 +554,11 @@ TEST(Accel, NoneSphereAndBvhGiveBitIdenticalImages) {
       const Image sphere = render(scene, o);
       o.accel = Accel::bvh;
       const Image bvh = render(scene, o);
+      o.simd = false;  // the baseline SSE2 paths (AVX2 ones above, where the CPU has it)
+      const Image bvh_sse2 = render(scene, o);
       EXPECT_EQ(none.rgb, sphere.rgb) << m.name << (dbl ? " double" : " float");
       EXPECT_EQ(none.rgb, bvh.rgb) << m.name << (dbl ? " double" : " float");
+      EXPECT_EQ(none.rgb, bvh_sse2.rgb) << m.name << (dbl ? " double" : " float");
     }
   }
 }
@@ -749,7 +752,7 @@ TEST(Accel, BvhLeavesHoldAtMostFourTrianglesAndEveryTriangleOnce) {
   std::vector<int> seen(lo.size(), 0);
   int leaves = 0;
   for (const auto& n : b.nodes)
-    for (int i = 0; i < 4; ++i) {
+    for (int i = 0; i < Bvh::kWidth; ++i) {
       if (!Bvh::is_leaf(n.child[i])) continue;
       ++leaves;
       const unsigned first = Bvh::leaf_first(n.child[i]), count = Bvh::leaf_count(n.child[i]);

@@ -110,6 +110,7 @@ struct Tracer::Impl {
       throw InputError("unknown sphere method \"" + o.sphere_method +
                        "\"; valid: " + method_names(Kind::sphere));
     pln_method = &default_method(Kind::plane);
+    avx2 = o.simd && __builtin_cpu_supports("avx2");
     if (o.samples_per_axis < 1 || o.samples_per_axis > 16)
       throw InputError("samples per axis must be between 1 and 16");
     mesh_index.assign(s.objects.size(), -1);
@@ -218,14 +219,15 @@ struct Tracer::Impl {
   }
 
   // Closest hit at precision T. The ray arrives in double (shading is done in
-  // double); the kernels see it converted to T.
+  // double); the kernels see it converted to T. Inlined into closest() and
+  // closest_avx2(), which compile it for baseline x86-64 and for AVX2.
   template <class T>
-  std::optional<SceneHit> closest(const Ray<double>& rd) const {
+  [[gnu::always_inline]] inline std::optional<SceneHit> closest_impl(const Ray<double>& rd) const {
     const Ray<T> r(rd);
     SceneHit best;
     best.t = std::numeric_limits<double>::infinity();
     Ray<T> window = r;
-    auto consider = [&](double t, int obj, int prim, double b1, double b2) {
+    auto consider = [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
       if (nearer(t, obj, prim, best)) {
         best = {t, obj, prim, b1, b2};
         window.tmax = T(t);
@@ -249,7 +251,7 @@ struct Tracer::Impl {
           const auto& k = tri_method->triangle<T>();
           if (opt.accel == Accel::bvh) {
             if (!m.tri4.empty()) {
-              traverse(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) {
+              traverse<true>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
                 moller_simd::Hit4<T> h;
                 moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
                 for (int hits = h.hits; hits; hits &= hits - 1) {
@@ -260,7 +262,7 @@ struct Tracer::Impl {
               });
               break;
             }
-            traverse(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) {
+            traverse<true>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
               for (std::uint32_t slot = first; slot < first + count; ++slot)
                 if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
                   consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
@@ -284,9 +286,9 @@ struct Tracer::Impl {
     return best;
   }
 
-  // Is anything in the ray's window? (shadow rays)
+  // Is anything in the ray's window? (shadow rays) Inlined as closest_impl.
   template <class T>
-  bool occluded(const Ray<T>& r) const {
+  [[gnu::always_inline]] inline bool occluded_impl(const Ray<T>& r) const {
     for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
       const Object& o = scene.objects[oi];
       switch (o.kind) {
@@ -302,13 +304,13 @@ struct Tracer::Impl {
           if (opt.accel == Accel::bvh) {
             bool hit = false;
             if (!m.tri4.empty()) {
-              traverse(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) {
+              traverse<false>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
                 moller_simd::Hit4<T> h;
                 moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
                 return hit = h.hits != 0;
               });
             } else {
-              traverse(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) {
+              traverse<false>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                 for (std::uint32_t slot = first; slot < first + count; ++slot)
                   if (k.any_pre(r, m.pre.data() + slot * m.stride, m.cull)) return hit = true;
                 return false;
@@ -329,6 +331,28 @@ struct Tracer::Impl {
     }
     return false;
   }
+
+  // The SIMD paths chosen at run time: the BVH's 8-wide box tests and the
+  // double leaves are one AVX register each where the CPU has AVX2, two SSE
+  // registers otherwise; the answers are the same bits either way.
+  bool avx2 = false;
+
+  template <class T>
+  std::optional<SceneHit> closest_base(const Ray<double>& rd) const { return closest_impl<T>(rd); }
+  template <class T>
+  [[gnu::target("avx2")]] std::optional<SceneHit> closest_avx2(const Ray<double>& rd) const {
+    return closest_impl<T>(rd);
+  }
+  template <class T>
+  std::optional<SceneHit> closest(const Ray<double>& rd) const {
+    return avx2 ? closest_avx2<T>(rd) : closest_base<T>(rd);
+  }
+  template <class T>
+  bool occluded_base(const Ray<T>& r) const { return occluded_impl<T>(r); }
+  template <class T>
+  [[gnu::target("avx2")]] bool occluded_avx2(const Ray<T>& r) const { return occluded_impl<T>(r); }
+  template <class T>
+  bool occluded(const Ray<T>& r) const { return avx2 ? occluded_avx2<T>(r) : occluded_base<T>(r); }
 
   std::optional<SceneHit> intersect(const Ray<double>& r) const {
     return opt.use_double ? closest<double>(r) : closest<float>(r);

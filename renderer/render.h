@@ -25,6 +25,9 @@ struct RenderOptions {
   int threads = 0;          // 0: all cores
   int samples_per_axis = 1; // n x n samples per pixel, averaged
   bool progress = true;     // a progress line on a terminal (stderr)
+  // Use AVX2 where the CPU has it (false: the baseline x86-64 SSE2 paths;
+  // both give the same bits, which the Accel tests check).
+  bool simd = true;
   // Shade a mesh hit where POV-Ray 3.7's mesh2 puts it (renderer/pov_mesh.h):
   // the point O + t D with t from the triangle's float32 plane, and normals
   // and UVs interpolated there through POV's float32 Perp vector. Which

@@ -1,10 +1,11 @@
-// Builds renderer/accel/bvh.h's 4-wide BVH: a binned SAH binary tree (Wald
-// 2007) collapsed to 4 children per node (largest box opened first).
+// Builds renderer/accel/bvh.h's 8-wide BVH: a binned SAH binary tree (Wald
+// 2007) collapsed to 8 children per node (largest box opened first).
 #include "bvh.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <thread>
 
 namespace ra {
 namespace {
@@ -12,17 +13,34 @@ namespace {
 // Past this depth splits are halvings: the tree is never deeper than
 // kMaxSahDepth + 32, within the traversal stack (Bvh::kMaxDepth).
 constexpr int kMaxSahDepth = 64;
+// Subtrees smaller than this are built on the thread that split them.
+constexpr std::uint32_t kMinParallel = 4096;
+
+typedef float v4f __attribute__((vector_size(16)));
+typedef int v4i __attribute__((vector_size(16)));
+
+// A triangle's box in float, rounded outward from double; lane 3 of lo
+// holds the triangle index (its bits), lane 3 of hi is unused. 32 bytes, so
+// binning and partitioning stream through memory.
+struct PrimRef {
+  v4f lo, hi;
+  std::uint32_t id() const {
+    std::uint32_t i;
+    __builtin_memcpy(&i, reinterpret_cast<const char*>(&lo) + 12, 4);
+    return i;
+  }
+};
 
 struct Box {
-  Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-  void grow(const Vec3d& l, const Vec3d& h) {
-    lo = vmin(lo, l);
-    hi = vmax(hi, h);
+  v4f lo = v4f{} + INFINITY, hi = v4f{} - INFINITY;
+  void grow(v4f l, v4f h) {
+    lo = l < lo ? l : lo;
+    hi = h > hi ? h : hi;
   }
   double area() const {
-    if (!(lo.x <= hi.x)) return 0;
-    const Vec3d e = hi - lo;
-    return 2 * (e.x * e.y + e.y * e.z + e.z * e.x);
+    if (!(lo[0] <= hi[0])) return 0;
+    const double ex = double(hi[0]) - lo[0], ey = double(hi[1]) - lo[1], ez = double(hi[2]) - lo[2];
+    return 2 * (ex * ey + ey * ez + ez * ex);
   }
 };
 
@@ -34,71 +52,78 @@ struct BinNode {
   std::uint16_t axis;
 };
 
+// Binned SAH over prims[begin, end): 16 bins per axis on the centroids
+// (twice the centroid: lo + hi), all three axes in one pass.
 struct Builder {
-  const std::vector<Vec3d>& lo;
-  const std::vector<Vec3d>& hi;
+  std::vector<PrimRef>& prims;
   double pad;
-  std::vector<Vec3d> centroid;
-  std::vector<std::uint32_t>& order;
-  std::vector<BinNode>& nodes;
+  std::vector<BinNode> nodes;
 
   void set_box(BinNode& n, const Box& b) const {
     for (int a = 0; a < 3; ++a) {
-      n.lo[a] = std::nextafter(float(b.lo[a] - pad), -INFINITY);
-      n.hi[a] = std::nextafter(float(b.hi[a] + pad), INFINITY);
+      n.lo[a] = std::nextafter(float(double(b.lo[a]) - pad), -INFINITY);
+      n.hi[a] = std::nextafter(float(double(b.hi[a]) + pad), INFINITY);
     }
   }
 
-  // Builds the subtree over order[begin, end); returns its node index.
-  std::uint32_t build(std::uint32_t begin, std::uint32_t end, int depth) {
+  static v4i bin_of(const PrimRef& p, v4f cmin, v4f k) {
+    const v4i b = __builtin_convertvector(((p.lo + p.hi) - cmin) * k, v4i);
+    const v4i top = v4i{} + (Bvh::kBins - 1);
+    return b < top ? (b > 0 ? b : v4i{}) : top;
+  }
+
+  // Builds the subtree over prims[begin, end) on up to `threads` threads;
+  // returns its node index.
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end, int depth, int threads) {
     const std::uint32_t me = std::uint32_t(nodes.size());
     nodes.push_back({});
     Box box, cbox;
     for (std::uint32_t i = begin; i < end; ++i) {
-      const auto t = order[i];
-      box.grow(lo[t], hi[t]);
-      cbox.grow(centroid[t], centroid[t]);
+      box.grow(prims[i].lo, prims[i].hi);
+      const v4f c = prims[i].lo + prims[i].hi;
+      cbox.grow(c, c);
     }
     set_box(nodes[me], box);
     const std::uint32_t n = end - begin;
-    auto make_leaf = [&] {
+    // Up to 4 triangles cost one leaf test whatever their number: a leaf.
+    if (n <= std::uint32_t(Bvh::kMaxLeaf)) {
       nodes[me].index = begin;
       nodes[me].count = std::uint16_t(n);
       return me;
-    };
-    if (n <= 1) return make_leaf();
-
-    // Binned SAH over the axis of the widest centroid spread... and the
-    // others: the best split of all three axes.
+    }
+    v4f k{};
+    for (int a = 0; a < 3; ++a) {
+      const float extent = cbox.hi[a] - cbox.lo[a];
+      k[a] = extent > 0 ? float(Bvh::kBins) * (1 - 0x1p-20f) / extent : 0.f;
+    }
+    Box bins[3][Bvh::kBins];
+    std::uint32_t counts[3][Bvh::kBins] = {};
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const v4i b = bin_of(prims[i], cbox.lo, k);
+      for (int a = 0; a < 3; ++a) {
+        bins[a][b[a]].grow(prims[i].lo, prims[i].hi);
+        ++counts[a][b[a]];
+      }
+    }
     int best_axis = -1, best_bin = -1;
     double best_cost = INFINITY;
     for (int a = 0; a < 3; ++a) {
-      const double extent = cbox.hi[a] - cbox.lo[a];
-      if (!(extent > 0)) continue;
-      Box bins[Bvh::kBins];
-      std::uint32_t counts[Bvh::kBins] = {};
-      const double k = Bvh::kBins / extent;
-      for (std::uint32_t i = begin; i < end; ++i) {
-        const auto t = order[i];
-        const int b = std::min(Bvh::kBins - 1, int((centroid[t][a] - cbox.lo[a]) * k));
-        bins[b].grow(lo[t], hi[t]);
-        ++counts[b];
-      }
+      if (k[a] == 0) continue;
       double right_area[Bvh::kBins];
       std::uint32_t right_count[Bvh::kBins];
       Box acc;
       std::uint32_t cnt = 0;
       for (int b = Bvh::kBins - 1; b > 0; --b) {
-        acc.grow(bins[b].lo, bins[b].hi);
-        cnt += counts[b];
+        acc.grow(bins[a][b].lo, bins[a][b].hi);
+        cnt += counts[a][b];
         right_area[b] = acc.area();
         right_count[b] = cnt;
       }
       Box left;
       std::uint32_t lcnt = 0;
       for (int b = 0; b < Bvh::kBins - 1; ++b) {
-        left.grow(bins[b].lo, bins[b].hi);
-        lcnt += counts[b];
+        left.grow(bins[a][b].lo, bins[a][b].hi);
+        lcnt += counts[a][b];
         if (lcnt == 0 || right_count[b + 1] == 0) continue;
         // Leaves are tested 4 triangles at a time: cost in blocks of 4.
         const double cost = left.area() * ((lcnt + 3) / 4) + right_area[b + 1] * ((right_count[b + 1] + 3) / 4);
@@ -109,9 +134,6 @@ struct Builder {
         }
       }
     }
-    // Up to 4 triangles cost one leaf test whatever their number: a leaf.
-    if (n <= std::uint32_t(Bvh::kMaxLeaf)) return make_leaf();
-
     std::uint32_t mid;
     if (best_axis < 0 || depth >= kMaxSahDepth) {
       // All centroids coincide, or a degenerate SAH chain got deep: halve
@@ -119,16 +141,27 @@ struct Builder {
       mid = begin + n / 2;
       best_axis = 0;
     } else {
-      const double extent = cbox.hi[best_axis] - cbox.lo[best_axis];
-      const double k = Bvh::kBins / extent;
-      auto it = std::partition(order.begin() + begin, order.begin() + end, [&](std::uint32_t t) {
-        return std::min(Bvh::kBins - 1, int((centroid[t][best_axis] - cbox.lo[best_axis]) * k)) <= best_bin;
-      });
-      mid = std::uint32_t(it - order.begin());
+      auto it = std::partition(prims.begin() + begin, prims.begin() + end,
+                               [&](const PrimRef& p) { return bin_of(p, cbox.lo, k)[best_axis] <= best_bin; });
+      mid = std::uint32_t(it - prims.begin());
       if (mid == begin || mid == end) mid = begin + n / 2;
     }
-    build(begin, mid, depth + 1);
-    const std::uint32_t right = build(mid, end, depth + 1);
+    std::uint32_t right;
+    if (threads > 1 && n >= kMinParallel) {
+      // The right subtree on another thread into its own nodes, appended
+      // after the left one with its child indices shifted.
+      Builder other{prims, pad, {}};
+      std::thread th([&] { other.build(mid, end, depth + 1, threads / 2); });
+      build(begin, mid, depth + 1, threads - threads / 2);
+      th.join();
+      right = std::uint32_t(nodes.size());
+      for (BinNode& b : other.nodes)
+        if (b.count == 0) b.index += right;
+      nodes.insert(nodes.end(), other.nodes.begin(), other.nodes.end());
+    } else {
+      build(begin, mid, depth + 1, 1);
+      right = build(mid, end, depth + 1, 1);
+    }
     nodes[me].index = right;
     nodes[me].count = 0;
     nodes[me].axis = std::uint16_t(best_axis);
@@ -154,16 +187,16 @@ struct Collapser {
     return Bvh::make_leaf(k, b.count);
   }
 
-  // Emits the 4-wide node for binary node `bi` (interior, or a root leaf).
+  // Emits the 8-wide node for binary node `bi` (interior, or a root leaf).
   std::uint32_t emit(std::uint32_t bi) {
-    std::uint32_t kids[4];
+    std::uint32_t kids[Bvh::kWidth];
     int n = 0;
     if (bin[bi].count > 0) {
       kids[n++] = bi;
     } else {
       kids[n++] = bi + 1;
       kids[n++] = bin[bi].index;
-      while (n < 4) {
+      while (n < Bvh::kWidth) {
         int best = -1;
         double best_area = -1;
         for (int i = 0; i < n; ++i)
@@ -179,8 +212,8 @@ struct Collapser {
     }
     const std::uint32_t me = std::uint32_t(out.nodes.size());
     out.nodes.emplace_back();
-    std::uint32_t child[4];
-    for (int i = 0; i < 4; ++i) {
+    std::uint32_t child[Bvh::kWidth];
+    for (int i = 0; i < Bvh::kWidth; ++i) {
       if (i >= n) {
         child[i] = Bvh::kEmpty;
         continue;
@@ -188,8 +221,8 @@ struct Collapser {
       const BinNode& b = bin[kids[i]];
       child[i] = b.count > 0 ? emit_leaf(b) : emit(kids[i]);
     }
-    BvhNode4& node = out.nodes[me];
-    for (int i = 0; i < 4; ++i) {
+    BvhNode& node = out.nodes[me];
+    for (int i = 0; i < Bvh::kWidth; ++i) {
       node.child[i] = child[i];
       for (int a = 0; a < 3; ++a) {
         node.lo[a][i] = i < n ? bin[kids[i]].lo[a] : INFINITY;
@@ -206,17 +239,25 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
   Bvh bvh;
   const std::size_t n = lo.size();
   if (n == 0) return bvh;
+  std::vector<PrimRef> prims(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      prims[i].lo[a] = bvh_detail::round_down(lo[i][a]);
+      prims[i].hi[a] = bvh_detail::round_up(hi[i][a]);
+    }
+    const std::uint32_t id = std::uint32_t(i);
+    __builtin_memcpy(reinterpret_cast<char*>(&prims[i].lo) + 12, &id, 4);
+    prims[i].hi[3] = 0;
+  }
+  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  Builder b{prims, pad, {}};
+  b.nodes.reserve(n / 2 + 1);
+  b.build(0, std::uint32_t(n), 0, threads);
   std::vector<std::uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  std::vector<BinNode> bin;
-  bin.reserve(2 * n / Bvh::kMaxLeaf + 1);
-  Builder b{lo, hi, pad, {}, order, bin};
-  b.centroid.resize(n);
-  for (std::size_t i = 0; i < n; ++i) b.centroid[i] = (lo[i] + hi[i]) * 0.5;
-  b.build(0, std::uint32_t(n), 0);
-  bvh.nodes.reserve(bin.size() / 3 + 1);
+  for (std::size_t i = 0; i < n; ++i) order[i] = prims[i].id();
+  bvh.nodes.reserve(b.nodes.size() / 7 + 1);
   bvh.order.reserve(4 * n);
-  Collapser{bin, order, bvh}.emit(0);
+  Collapser{b.nodes, order, bvh}.emit(0);
   return bvh;
 }
 

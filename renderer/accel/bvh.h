@@ -1,9 +1,9 @@
-// A 4-wide bounding volume hierarchy over one mesh's triangles, the modern
+// An 8-wide bounding volume hierarchy over one mesh's triangles, the modern
 // reference next to document 002's optimisations (backface culling, the
 // bounding sphere in bounding_sphere.h). Sources: binned SAH (Wald 2007, "On
-// fast construction of SAH-based BVHs"), collapsed to 4 children per node
+// fast construction of SAH-based BVHs"), collapsed to 8 children per node
 // (Dammertz et al. 2008, "Shallow bounding volume hierarchies"; Embree's
-// BVH4), and boxes tested 4 at a time in float with the rounding made
+// BVH8), and boxes tested 8 at a time in float with the rounding made
 // conservative (Ize 2013, "Robust BVH Ray Traversal"; Embree's robust mode).
 //
 // Guarantee: every leaf whose padded box the exact ray segment [tmin, tmax]
@@ -32,6 +32,7 @@
 #include <immintrin.h>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -40,24 +41,25 @@
 
 namespace ra {
 
-// Four children's boxes, structure of arrays: lo[axis][child]. 128 bytes,
-// two cache lines, aligned.
-struct alignas(64) BvhNode4 {
-  float lo[3][4];
-  float hi[3][4];
-  std::uint32_t child[4];  // Bvh::kEmpty, a leaf (Bvh::kLeaf | ...) or a node index
+// Eight children's boxes, structure of arrays: lo[axis][child]. 256 bytes
+// (224 used), four cache lines, aligned.
+struct alignas(64) BvhNode {
+  float lo[3][8];
+  float hi[3][8];
+  std::uint32_t child[8];  // Bvh::kEmpty, a leaf (Bvh::kLeaf | ...) or a node index
 };
 
 struct Bvh {
+  static constexpr int kWidth = 8;  // children per node
   static constexpr int kBins = 16;
   static constexpr int kMaxLeaf = 4;       // triangles per leaf; every leaf owns 4 slots
-  static constexpr int kMaxDepth = 128;    // binary depth bound (build); 4-wide depth is below it
+  static constexpr int kMaxDepth = 128;    // binary depth bound (build); 8-wide depth is below it
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
   static constexpr std::uint32_t kLeaf = 0x80000000u;      // child word: leaf flag
   static constexpr std::uint32_t kNoTriangle = 0xFFFFFFFFu;  // order[] of an unused slot
   static constexpr float kRelSlack = 1.0f / (1 << 20);
 
-  std::vector<BvhNode4> nodes;       // nodes[0] is the root (empty for an empty mesh)
+  std::vector<BvhNode> nodes;       // nodes[0] is the root (empty for an empty mesh)
   std::vector<std::uint32_t> order;  // slot -> triangle; leaf k's slots are 4k .. 4k + count - 1
 
   static bool is_leaf(std::uint32_t c) { return c != kEmpty && (c & kLeaf); }
@@ -76,40 +78,51 @@ struct Bvh {
 
 namespace bvh_detail {
 
-typedef float v4f __attribute__((vector_size(16)));
-typedef int v4i __attribute__((vector_size(16)));
+// 8 lanes: one AVX register where the caller is compiled for AVX2 (the
+// tracer's AVX2 entry points), two SSE registers otherwise.
+typedef float v8f __attribute__((vector_size(32)));
+typedef int v8i __attribute__((vector_size(32)));
 
-inline v4f load4(const float* p) {
-  v4f v;
+[[gnu::always_inline]] inline v8f load8(const float* p) {
+  v8f v;
   __builtin_memcpy(&v, p, sizeof v);
   return v;
 }
-inline v4f splat(float x) { return v4f{x, x, x, x}; }
-inline v4f vabs(v4f x) {
-  return (v4f)((v4i)x & v4i{0x7FFFFFFF, 0x7FFFFFFF, 0x7FFFFFFF, 0x7FFFFFFF});
+[[gnu::always_inline]] inline v8f splat(float x) { return v8f{} + x; }
+[[gnu::always_inline]] inline v8f vabs(v8f x) { return (v8f)((v8i)x & 0x7FFFFFFF); }
+[[gnu::always_inline]] inline int movemask(v8i m) {
+  __m128 lo, hi;
+  __builtin_memcpy(&lo, &m, 16);
+  __builtin_memcpy(&hi, reinterpret_cast<const char*>(&m) + 16, 16);
+  return _mm_movemask_ps(lo) | _mm_movemask_ps(hi) << 4;
 }
 
 // float rounded towards -inf / +inf from double.
+// A step of a relative 2^-23 (at least one ulp for normal floats) instead
+// of nextafter's call; below 1e-30 in magnitude, an absolute 1e-30 step,
+// far more than the half ulp float(x) can be off there.
 inline float round_down(double x) {
-  float f = float(x);
-  if (double(f) > x) f = std::nextafter(f, -INFINITY);
-  return f;
+  const float f = float(x);
+  if (!(double(f) > x)) return f;
+  return f > 1e-30f ? f * (1 - 0x1p-23f) : f < -1e-30f ? f * (1 + 0x1p-23f) : f - 1e-30f;
 }
 inline float round_up(double x) {
-  float f = float(x);
-  if (double(f) < x) f = std::nextafter(f, INFINITY);
-  return f;
+  const float f = float(x);
+  if (!(double(f) < x)) return f;
+  return f > 1e-30f ? f * (1 + 0x1p-23f) : f < -1e-30f ? f * (1 - 0x1p-23f) : f + 1e-30f;
 }
 
 // The ray as the box test sees it.
 struct BoxRay {
-  v4f o[3], inv[3];
-  int near_hi[3];  // 1 when d_a < 0 (or -0): the near plane is hi
-  v4f tmin;
+  v8f o[3], inv[3];
+  // Byte offsets in BvhNode of each axis's near and far planes (hi is the
+  // near plane when d_a < 0, or -0).
+  unsigned near_off[3], far_off[3];
+  v8f tmin;
   bool exact = true;  // false: float cannot hold this ray; visit every leaf
 };
 
-inline BoxRay box_ray(const Vec3d& o, const Vec3d& d, double tmin) {
+[[gnu::always_inline]] inline BoxRay box_ray(const Vec3d& o, const Vec3d& d, double tmin) {
   BoxRay b;
   for (int a = 0; a < 3; ++a) {
     const double inv = 1.0 / d[a];
@@ -119,7 +132,9 @@ inline BoxRay box_ray(const Vec3d& o, const Vec3d& d, double tmin) {
       b.exact = false;
     b.o[a] = splat(of);
     b.inv[a] = splat(invf);
-    b.near_hi[a] = std::signbit(invf) ? 1 : 0;
+    const bool near_hi = std::signbit(invf);
+    b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
+    b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
   }
   b.tmin = splat(round_down(tmin));
   return b;
@@ -127,31 +142,33 @@ inline BoxRay box_ray(const Vec3d& o, const Vec3d& d, double tmin) {
 
 // Bit i set: child i's box meets [tmin, tmax]; tnear gets each box's
 // lower bound of the entry t (for ordering and pruning).
-inline int meet4(const BvhNode4& n, const BoxRay& r, float tmax, v4f& tnear) {
-  v4f tn = r.tmin, tf = splat(tmax);
+[[gnu::always_inline]] inline int meet8(const BvhNode& n, const BoxRay& r, float tmax, v8f& tnear) {
+  v8f tn = r.tmin, tf = splat(tmax);
   for (int a = 0; a < 3; ++a) {
-    const v4f nearp = load4(r.near_hi[a] ? n.hi[a] : n.lo[a]);
-    const v4f farp = load4(r.near_hi[a] ? n.lo[a] : n.hi[a]);
-    const v4f t0 = (nearp - r.o[a]) * r.inv[a];
-    const v4f t1 = (farp - r.o[a]) * r.inv[a];
+    const char* base = reinterpret_cast<const char*>(&n);
+    const v8f nearp = load8(reinterpret_cast<const float*>(base + r.near_off[a]));
+    const v8f farp = load8(reinterpret_cast<const float*>(base + r.far_off[a]));
+    const v8f t0 = (nearp - r.o[a]) * r.inv[a];
+    const v8f t1 = (farp - r.o[a]) * r.inv[a];
     // NaN (origin exactly on the plane of a d_a = 0 slab) keeps the old bound.
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
   }
-  const v4f slack = splat(Bvh::kRelSlack);
+  const v8f slack = splat(Bvh::kRelSlack);
   tnear = tn - vabs(tn) * slack;
-  const v4f far_up = tf + vabs(tf) * slack;
-  return _mm_movemask_ps((__m128)(tnear <= far_up));
+  const v8f far_up = tf + vabs(tf) * slack;
+  return movemask(tnear <= far_up);
 }
 
 }  // namespace bvh_detail
 
-// Visits the leaves whose boxes the ray's window meets, nearest box first;
-// `leaf(first_slot, count)` returns true to stop. `tmax` is re-read after
-// every leaf (closest-hit shrinks it), and boxes entered beyond it are
-// skipped.
-template <class T, class Leaf>
-void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax, Leaf&& leaf) {
+// Visits the leaves whose boxes the ray's window meets; `leaf(first_slot,
+// count)` returns true to stop. kClosest: nearest box first, `tmax` re-read
+// after every leaf (closest-hit shrinks it) and boxes entered beyond it
+// skipped; otherwise (any hit) in node order, without sorting.
+// Always inlined, so that it is compiled for the ISA of its caller.
+template <bool kClosest, class T, class Leaf>
+[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax, Leaf&& leaf) {
   using namespace bvh_detail;
   if (bvh.nodes.empty()) return;
   const BoxRay r = box_ray(Vec3d(o), Vec3d(d), double(tmin));
@@ -159,47 +176,61 @@ void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const 
     std::uint32_t node;
     float tnear;
   };
-  Entry stack[3 * Bvh::kMaxDepth + 4];
+  Entry stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
   int top = 0;
   float tmax_f = round_up(double(tmax));
   stack[top++] = {0, -INFINITY};
   while (top > 0) {
     const Entry e = stack[--top];
-    if (e.tnear > tmax_f) continue;
-    const BvhNode4& n = bvh.nodes[e.node];
-    v4f tn;
+    if (kClosest && e.tnear > tmax_f) continue;
+    const BvhNode& n = bvh.nodes[e.node];
+    alignas(32) float tn[8];
     int mask;
     if (r.exact) {
-      mask = meet4(n, r, tmax_f, tn);
+      v8f tnv;
+      mask = meet8(n, r, tmax_f, tnv);
+      __builtin_memcpy(tn, &tnv, sizeof tn);
     } else {
       mask = 0;
-      for (int i = 0; i < 4; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
-      tn = splat(-INFINITY);
+      for (int i = 0; i < 8; ++i) {
+        mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
+        tn[i] = -INFINITY;
+      }
     }
     if (!mask) continue;
-    // Children hit, sorted far to near so the nearest is pushed last.
-    Entry hit[4];
-    int k = 0;
-    for (; mask; mask &= mask - 1) {
-      const int i = __builtin_ctz(unsigned(mask));
-      Entry c{n.child[i], tn[i]};
-      int j = k++;
-      while (j > 0 && hit[j - 1].tnear < c.tnear) {
-        hit[j] = hit[j - 1];
-        --j;
+    if constexpr (!kClosest) {
+      for (; mask; mask &= mask - 1) {
+        const int i = __builtin_ctz(unsigned(mask));
+        const std::uint32_t c = n.child[i];
+        if (Bvh::is_leaf(c)) {
+          if (leaf(Bvh::leaf_first(c), Bvh::leaf_count(c))) return;
+        } else {
+          stack[top++] = {c, tn[i]};
+        }
       }
-      hit[j] = c;
-    }
-    for (int i = 0; i < k; ++i) {
-      if (Bvh::is_leaf(hit[i].node)) continue;
-      stack[top++] = hit[i];
-    }
-    // Leaves now, nearest first (they were sorted far to near).
-    for (int i = k - 1; i >= 0; --i) {
-      if (!Bvh::is_leaf(hit[i].node)) continue;
-      if (hit[i].tnear > tmax_f) continue;
-      if (leaf(Bvh::leaf_first(hit[i].node), Bvh::leaf_count(hit[i].node))) return;
-      tmax_f = round_up(double(tmax));
+      continue;
+    } else {
+      // Children hit, sorted far to near so the nearest is pushed last.
+      Entry hit[8];
+      int k = 0;
+      for (; mask; mask &= mask - 1) {
+        const int i = __builtin_ctz(unsigned(mask));
+        Entry c{n.child[i], tn[i]};
+        int j = k++;
+        while (j > 0 && hit[j - 1].tnear < c.tnear) {
+          hit[j] = hit[j - 1];
+          --j;
+        }
+        hit[j] = c;
+      }
+      for (int i = 0; i < k; ++i)
+        if (!Bvh::is_leaf(hit[i].node)) stack[top++] = hit[i];
+      // Leaves now, nearest first: a hit there shrinks tmax for the rest.
+      for (int i = k - 1; i >= 0; --i) {
+        if (!Bvh::is_leaf(hit[i].node) || hit[i].tnear > tmax_f) continue;
+        if (leaf(Bvh::leaf_first(hit[i].node), Bvh::leaf_count(hit[i].node))) return;
+        tmax_f = round_up(double(tmax));
+      }
     }
   }
 }
