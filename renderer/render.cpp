@@ -203,12 +203,8 @@ struct Tracer::Impl {
       for (std::size_t s = 0; s < slots; ++s) {
         if (m.bvh.order[s] == Bvh::kNoTriangle) continue;
         const auto& tri = set.triangles[m.bvh.order[s]];
-        auto& blk = m.tri4[s / 4];
-        for (int a = 0; a < 3; ++a) {
-          blk.a[a][s % 4] = T(set.positions[tri.v[0]][a]);
-          blk.b[a][s % 4] = T(set.positions[tri.v[1]][a]);
-          blk.c[a][s % 4] = T(set.positions[tri.v[2]][a]);
-        }
+        m.tri4[s / 4].set(int(s % 4), Vec3<T>(set.positions[tri.v[0]]), Vec3<T>(set.positions[tri.v[1]]),
+                          Vec3<T>(set.positions[tri.v[2]]));
       }
     }
   }

@@ -165,10 +165,12 @@ struct BoxRay {
 // Visits the leaves whose boxes the ray's window meets; `leaf(first_slot,
 // count)` returns true to stop. kClosest: nearest box first, `tmax` re-read
 // after every leaf (closest-hit shrinks it) and boxes entered beyond it
-// skipped; otherwise (any hit) in node order, without sorting.
+// skipped; otherwise (any hit) in node order, without sorting. The nearest
+// child hit is visited next without going through the stack.
 // Always inlined, so that it is compiled for the ISA of its caller.
 template <bool kClosest, class T, class Leaf>
-[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax, Leaf&& leaf) {
+[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
+                                            Leaf&& leaf) {
   using namespace bvh_detail;
   if (bvh.nodes.empty()) return;
   const BoxRay r = box_ray(Vec3d(o), Vec3d(d), double(tmin));
@@ -179,58 +181,67 @@ template <bool kClosest, class T, class Leaf>
   Entry stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
   int top = 0;
   float tmax_f = round_up(double(tmax));
-  stack[top++] = {0, -INFINITY};
-  while (top > 0) {
-    const Entry e = stack[--top];
-    if (kClosest && e.tnear > tmax_f) continue;
-    const BvhNode& n = bvh.nodes[e.node];
-    alignas(32) float tn[8];
-    int mask;
-    if (r.exact) {
-      v8f tnv;
-      mask = meet8(n, r, tmax_f, tnv);
-      __builtin_memcpy(tn, &tnv, sizeof tn);
+  std::uint32_t cur = 0;  // the root is a node (a lone leaf gets one)
+  for (;;) {
+    if (Bvh::is_leaf(cur)) {
+      if (leaf(Bvh::leaf_first(cur), Bvh::leaf_count(cur))) return;
+      if constexpr (kClosest) tmax_f = round_up(double(tmax));
     } else {
-      mask = 0;
-      for (int i = 0; i < 8; ++i) {
-        mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
-        tn[i] = -INFINITY;
+      const BvhNode& n = bvh.nodes[cur];
+      alignas(32) float tn[8];
+      int mask;
+      if (r.exact) {
+        v8f tnv;
+        mask = meet8(n, r, tmax_f, tnv);
+        __builtin_memcpy(tn, &tnv, sizeof tn);
+      } else {
+        mask = 0;
+        for (int i = 0; i < 8; ++i) {
+          mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
+          tn[i] = -INFINITY;
+        }
+      }
+      if (mask) {
+        int i = __builtin_ctz(unsigned(mask));
+        mask &= mask - 1;
+        if (!mask) {  // one child: straight to it
+          cur = n.child[i];
+          continue;
+        }
+        if constexpr (!kClosest) {
+          cur = n.child[i];
+          for (; mask; mask &= mask - 1) {
+            const int j = __builtin_ctz(unsigned(mask));
+            stack[top++] = {n.child[j], tn[j]};
+          }
+          continue;
+        } else {
+          // Push all hit children sorted so the nearest is on top, then
+          // take it.
+          const int base = top;
+          stack[top++] = {n.child[i], tn[i]};
+          for (; mask; mask &= mask - 1) {
+            const int j = __builtin_ctz(unsigned(mask));
+            const Entry c{n.child[j], tn[j]};
+            int k = top++;
+            while (k > base && stack[k - 1].tnear < c.tnear) {
+              stack[k] = stack[k - 1];
+              --k;
+            }
+            stack[k] = c;
+          }
+          cur = stack[--top].node;
+          continue;
+        }
       }
     }
-    if (!mask) continue;
-    if constexpr (!kClosest) {
-      for (; mask; mask &= mask - 1) {
-        const int i = __builtin_ctz(unsigned(mask));
-        const std::uint32_t c = n.child[i];
-        if (Bvh::is_leaf(c)) {
-          if (leaf(Bvh::leaf_first(c), Bvh::leaf_count(c))) return;
-        } else {
-          stack[top++] = {c, tn[i]};
-        }
-      }
-      continue;
-    } else {
-      // Children hit, sorted far to near so the nearest is pushed last.
-      Entry hit[8];
-      int k = 0;
-      for (; mask; mask &= mask - 1) {
-        const int i = __builtin_ctz(unsigned(mask));
-        Entry c{n.child[i], tn[i]};
-        int j = k++;
-        while (j > 0 && hit[j - 1].tnear < c.tnear) {
-          hit[j] = hit[j - 1];
-          --j;
-        }
-        hit[j] = c;
-      }
-      for (int i = 0; i < k; ++i)
-        if (!Bvh::is_leaf(hit[i].node)) stack[top++] = hit[i];
-      // Leaves now, nearest first: a hit there shrinks tmax for the rest.
-      for (int i = k - 1; i >= 0; --i) {
-        if (!Bvh::is_leaf(hit[i].node) || hit[i].tnear > tmax_f) continue;
-        if (leaf(Bvh::leaf_first(hit[i].node), Bvh::leaf_count(hit[i].node))) return;
-        tmax_f = round_up(double(tmax));
-      }
+    // Next from the stack, skipping boxes entered beyond the closest hit.
+    for (;;) {
+      if (top == 0) return;
+      const Entry e = stack[--top];
+      if (kClosest && e.tnear > tmax_f) continue;
+      cur = e.node;
+      break;
     }
   }
 }

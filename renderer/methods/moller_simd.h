@@ -13,11 +13,21 @@
 
 namespace ra::moller_simd {
 
-// 4 triangles' vertices, structure of arrays: a[axis][lane]. Unused lanes
-// are all zero (det = 0: never a hit).
+// 4 triangles, structure of arrays: a[axis][lane] and the edges e1 = b - a,
+// e2 = c - a rounded to T once here, which are the very values moller::hit
+// computes from the same T vertices on every call. Unused lanes are all zero
+// (det = 0: never a hit).
 template <class T>
 struct alignas(32) Tri4 {
-  T a[3][4], b[3][4], c[3][4];
+  T a[3][4], e1[3][4], e2[3][4];
+  void set(int lane, const Vec3<T>& va, const Vec3<T>& vb, const Vec3<T>& vc) {
+    const Vec3<T> d1 = vb - va, d2 = vc - va;
+    for (int k = 0; k < 3; ++k) {
+      a[k][lane] = va[k];
+      e1[k][lane] = d1[k];
+      e2[k][lane] = d2[k];
+    }
+  }
 };
 
 template <class T> struct Lanes;
@@ -50,9 +60,8 @@ template <class T>
   using M = typename Lanes<T>::M;
   const V dx = V{} + r.d.x, dy = V{} + r.d.y, dz = V{} + r.d.z;
   const V ax = load(tri.a[0]), ay = load(tri.a[1]), az = load(tri.a[2]);
-  // e1 = b - a, e2 = c - a
-  const V e1x = load(tri.b[0]) - ax, e1y = load(tri.b[1]) - ay, e1z = load(tri.b[2]) - az;
-  const V e2x = load(tri.c[0]) - ax, e2y = load(tri.c[1]) - ay, e2z = load(tri.c[2]) - az;
+  const V e1x = load(tri.e1[0]), e1y = load(tri.e1[1]), e1z = load(tri.e1[2]);
+  const V e2x = load(tri.e2[0]), e2y = load(tri.e2[1]), e2z = load(tri.e2[2]);
   // p = cross(d, e2)
   const V px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
   const V det = e1x * px + e1y * py + e1z * pz;

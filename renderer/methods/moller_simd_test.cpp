@@ -23,12 +23,7 @@ bool same_bits(T a, T b) {
 template <class T>
 int compare_block(const Ray<T>& r, const Vec3<T> (&v)[4][3], bool cull) {
   moller_simd::Tri4<T> blk{};
-  for (int l = 0; l < 4; ++l)
-    for (int a = 0; a < 3; ++a) {
-      blk.a[a][l] = v[l][0][a];
-      blk.b[a][l] = v[l][1][a];
-      blk.c[a][l] = v[l][2][a];
-    }
+  for (int l = 0; l < 4; ++l) blk.set(l, v[l][0], v[l][1], v[l][2]);
   moller_simd::Hit4<T> h;
   moller_simd::hit4(r, blk, cull, h);
   int hits = 0;
