@@ -120,6 +120,9 @@ struct BoxRay {
   unsigned near_off[3], far_off[3];
   v8f tmin;
   bool exact = true;  // false: float cannot hold this ray; visit every leaf
+  // tmin >= 0 (every ray the tracer casts): then tnear >= 0, and tfar may
+  // carry all the slack (Ize 2013's one-sided test, 2 operations fewer).
+  bool nonneg = false;
 };
 
 [[gnu::always_inline]] inline BoxRay box_ray(const Vec3d& o, const Vec3d& d, double tmin) {
@@ -136,7 +139,9 @@ struct BoxRay {
     b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
     b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
   }
-  b.tmin = splat(round_down(tmin));
+  const float tmin_f = round_down(tmin);
+  b.tmin = splat(tmin_f);
+  b.nonneg = tmin_f >= 0;
   return b;
 }
 
@@ -153,6 +158,14 @@ struct BoxRay {
     // NaN (origin exactly on the plane of a d_a = 0 slab) keeps the old bound.
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
+  }
+  if (r.nonneg) {
+    // tn >= 0, so a hit needs tf >= 0 too: true tnear >= tn (1 - s) and true
+    // tfar <= tf (1 + s), and tn (1 - s) <= tf (1 + s) is within
+    // tn <= tf (1 + 4 s). tnear is not lowered: callers prune against
+    // tmax (1 + 4 s) (traverse's `prune`).
+    tnear = tn;
+    return movemask(tn <= tf * splat(1 + 4 * Bvh::kRelSlack));
   }
   const v8f slack = splat(Bvh::kRelSlack);
   tnear = tn - vabs(tn) * slack;
@@ -181,11 +194,17 @@ template <bool kClosest, class T, class Leaf>
   Entry stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
   int top = 0;
   float tmax_f = round_up(double(tmax));
+  // What a box's tnear must exceed to be skipped (see meet8).
+  const float prune_scale = r.nonneg ? 1 + 4 * Bvh::kRelSlack : 1.f;
+  float prune = tmax_f * prune_scale;
   std::uint32_t cur = 0;  // the root is a node (a lone leaf gets one)
   for (;;) {
     if (Bvh::is_leaf(cur)) {
       if (leaf(Bvh::leaf_first(cur), Bvh::leaf_count(cur))) return;
-      if constexpr (kClosest) tmax_f = round_up(double(tmax));
+      if constexpr (kClosest) {
+        tmax_f = round_up(double(tmax));
+        prune = tmax_f * prune_scale;
+      }
     } else {
       const BvhNode& n = bvh.nodes[cur];
       alignas(32) float tn[8];
@@ -239,7 +258,7 @@ template <bool kClosest, class T, class Leaf>
     for (;;) {
       if (top == 0) return;
       const Entry e = stack[--top];
-      if (kClosest && e.tnear > tmax_f) continue;
+      if (kClosest && e.tnear > prune) continue;
       cur = e.node;
       break;
     }
