@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "bump.h"
+#include "accel/bounding_sphere.h"
 #include "accel/bvh.h"
 #include "camera.h"
 #include "errors.h"
@@ -61,18 +62,6 @@ struct PreparedMesh {
   double bs_radius = 0;
   bool cull = false;  // --cull, and the mesh is closed (cull_unsafe_reason)
 };
-
-// Does the segment [tmin, tmax] of the ray pass through the solid ball?
-// Conservative (inflated by a relative 1e-6) so that it never rejects a mesh
-// the ray could hit.
-bool segment_meets_ball(const Ray<double>& r, const Vec3d& c, double radius) {
-  const double dd = dot(r.d, r.d);
-  double t = dot(c - r.o, r.d) / dd;
-  t = std::clamp(t, r.tmin, std::isfinite(r.tmax) ? r.tmax : std::max(t, r.tmin));
-  const Vec3d q = r.o + r.d * t - c;
-  const double rr = radius * (1 + 1e-6) + 1e-12 * length(c);
-  return dot(q, q) <= rr * rr;
-}
 
 // Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
 // object, then the lower triangle, so the answer does not depend on the order
