@@ -161,7 +161,22 @@ int main(int argc, char** argv) {
     }
     return median(rates);
   };
-  long he = 0, ho = 0, se = 0, so = 0;
+  // Rays pointing away from the mesh: what a ray costs before any box.
+  std::vector<ra::Ray<double>> away;
+  for (const auto& r : primary) away.push_back({r.o, -r.d, 0, INFINITY});
+  auto embree_away = [&](long& hits) {
+    std::swap(primary, away);
+    embree_primary(hits);
+    std::swap(primary, away);
+  };
+  auto ours_away = [&](long& hits) {
+    std::swap(primary, away);
+    ours_primary(hits);
+    std::swap(primary, away);
+  };
+  long he = 0, ho = 0, se = 0, so = 0, ae = 0, ao = 0;
+  const double ea = time(embree_away, ae, away.size());
+  const double oa = time(ours_away, ao, away.size());
   const double ep = time(embree_primary, he, primary.size());
   const double op = time(ours_primary, ho, primary.size());
   const double esr = time(embree_shadow, se, shadow.size());
@@ -172,6 +187,7 @@ int main(int argc, char** argv) {
   std::printf("primary embree %.2f Mrays/s  ours %.2f  ratio %.3f  hits %ld / %ld\n", ep, op, op / ep, he, ho);
   std::printf("shadow  embree %.2f Mrays/s  ours %.2f  ratio %.3f  occluded %ld / %ld of %zu\n", esr, osr, osr / esr,
               se, so, shadow.size());
+  std::printf("away    embree %.2f Mrays/s  ours %.2f  ratio %.3f  (rays missing everything)\n", ea, oa, oa / ea);
   rtcReleaseScene(es);
   rtcReleaseDevice(dev);
   return 0;

@@ -20,7 +20,8 @@
 //    <= 2^-24 * 2 size, far below the padding; farther out every box plane
 //    is at least |o_a| / 2 away, so the error is at most 2^-23 relative to
 //    (plane - o_a), i.e. relative in t;
-//  - 1/d rounded to float, the subtraction and the product add 3 roundings:
+//  - 1/d rounded to float (from double for double rays), the subtraction
+//    and the product add 3 roundings:
 //    all of it is relative to t, covered by widening [tnear, tfar] by
 //    kRelSlack = 2^-20 (16 float ulps) of their magnitudes;
 //  - d_a = 0 gives 1/d_a = +-inf: (plane - o_a) * inf is +-inf, or NaN when
@@ -125,21 +126,35 @@ struct BoxRay {
   bool nonneg = false;
 };
 
-[[gnu::always_inline]] inline BoxRay box_ray(const Vec3d& o, const Vec3d& d, double tmin) {
+// One vector division for the three 1/d_a: in float for float rays (the
+// correctly rounded 1/d), in double then rounded for double rays.
+template <class T>
+[[gnu::always_inline]] inline BoxRay box_ray(const Vec3<T>& o, const Vec3<T>& d, T tmin) {
+  typedef float v4 __attribute__((vector_size(16)));
+  typedef double v4d __attribute__((vector_size(32)));
+  typedef int v4m __attribute__((vector_size(16)));
+  v4 inv;
+  if constexpr (sizeof(T) == sizeof(float)) {
+    inv = v4{1, 1, 1, 1} / v4{d.x, d.y, d.z, 1};
+  } else {
+    inv = __builtin_convertvector(v4d{1, 1, 1, 1} / v4d{d.x, d.y, d.z, 1}, v4);
+  }
+  const v4 of{float(o.x), float(o.y), float(o.z), 0};
+  const v4 dz{float(d.x == 0), float(d.y == 0), float(d.z == 0), 1};
+  const v4 abs_inv = (v4)((v4m)inv & 0x7FFFFFFF), abs_o = (v4)((v4m)of & 0x7FFFFFFF);
+  // Float must hold the origin, and 1/d_a must be a normal float unless d_a = 0.
+  const v4m ok = (abs_o <= 1e30f) & ((dz != 0) | ((abs_inv >= std::numeric_limits<float>::min()) &
+                                                   (abs_inv <= std::numeric_limits<float>::max())));
   BoxRay b;
+  b.exact = _mm_movemask_ps((__m128)ok) == 0xF;
   for (int a = 0; a < 3; ++a) {
-    const double inv = 1.0 / d[a];
-    const float of = float(o[a]), invf = float(inv);
-    if (!(std::abs(of) <= 1e30f)) b.exact = false;
-    if (d[a] != 0 && !(std::abs(invf) >= std::numeric_limits<float>::min() && std::isfinite(invf)))
-      b.exact = false;
-    b.o[a] = splat(of);
-    b.inv[a] = splat(invf);
-    const bool near_hi = std::signbit(invf);
+    b.o[a] = splat(of[a]);
+    b.inv[a] = splat(inv[a]);
+    const bool near_hi = std::signbit(inv[a]);
     b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
     b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
   }
-  const float tmin_f = round_down(tmin);
+  const float tmin_f = round_down(double(tmin));
   b.tmin = splat(tmin_f);
   b.nonneg = tmin_f >= 0;
   return b;
@@ -186,7 +201,7 @@ template <bool kClosest, class T, class Leaf>
                                             Leaf&& leaf) {
   using namespace bvh_detail;
   if (bvh.nodes.empty()) return;
-  const BoxRay r = box_ray(Vec3d(o), Vec3d(d), double(tmin));
+  const BoxRay r = box_ray(o, d, tmin);
   struct Entry {
     std::uint32_t node;
     float tnear;
