@@ -31,8 +31,11 @@ struct PrimRef {
   }
 };
 
+// No default initialisation (bins are cleared only as far as used):
+// start from Box::empty().
 struct Box {
-  v4f lo = v4f{} + INFINITY, hi = v4f{} - INFINITY;
+  v4f lo, hi;
+  static Box empty() { return {v4f{} + INFINITY, v4f{} - INFINITY}; }
   void grow(v4f l, v4f h) {
     lo = l < lo ? l : lo;
     hi = h > hi ? h : hi;
@@ -61,28 +64,31 @@ struct Builder {
 
   void set_box(BinNode& n, const Box& b) const {
     for (int a = 0; a < 3; ++a) {
-      n.lo[a] = std::nextafter(float(double(b.lo[a]) - pad), -INFINITY);
-      n.hi[a] = std::nextafter(float(double(b.hi[a]) + pad), INFINITY);
+      n.lo[a] = bvh_detail::round_down(double(b.lo[a]) - pad);
+      n.hi[a] = bvh_detail::round_up(double(b.hi[a]) + pad);
     }
   }
 
-  static v4i bin_of(const PrimRef& p, v4f cmin, v4f k) {
+  static v4i bin_of(const PrimRef& p, v4f cmin, v4f k, int nb) {
     const v4i b = __builtin_convertvector(((p.lo + p.hi) - cmin) * k, v4i);
-    const v4i top = v4i{} + (Bvh::kBins - 1);
+    const v4i top = v4i{} + (nb - 1);
     return b < top ? (b > 0 ? b : v4i{}) : top;
   }
 
-  // Builds the subtree over prims[begin, end) on up to `threads` threads;
-  // returns its node index.
-  std::uint32_t build(std::uint32_t begin, std::uint32_t end, int depth, int threads) {
-    const std::uint32_t me = std::uint32_t(nodes.size());
-    nodes.push_back({});
-    Box box, cbox;
+  // The boxes of prims[begin, end) and of their (doubled) centroids.
+  void bounds(std::uint32_t begin, std::uint32_t end, Box& box, Box& cbox) const {
     for (std::uint32_t i = begin; i < end; ++i) {
       box.grow(prims[i].lo, prims[i].hi);
       const v4f c = prims[i].lo + prims[i].hi;
       cbox.grow(c, c);
     }
+  }
+
+  // Builds the subtree over prims[begin, end), whose bounds are box and cbox,
+  // on up to `threads` threads; returns its node index.
+  std::uint32_t build(std::uint32_t begin, std::uint32_t end, const Box& box, const Box& cbox, int depth, int threads) {
+    const std::uint32_t me = std::uint32_t(nodes.size());
+    nodes.push_back({});
     set_box(nodes[me], box);
     const std::uint32_t n = end - begin;
     // Up to 4 triangles cost one leaf test whatever their number: a leaf.
@@ -96,32 +102,60 @@ struct Builder {
       const float extent = cbox.hi[a] - cbox.lo[a];
       k[a] = extent > 0 ? float(Bvh::kBins) * (1 - 0x1p-20f) / extent : 0.f;
     }
-    Box bins[3][Bvh::kBins];
-    std::uint32_t counts[3][Bvh::kBins] = {};
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const v4i b = bin_of(prims[i], cbox.lo, k);
+    // Two sets of bins, even and odd primitives, merged after: consecutive
+    // primitives often fall in the same bin, and one set would chain every
+    // update on the previous one's store. Small ranges use fewer bins (the
+    // per-node cost of clearing and sweeping them dominates near the leaves).
+    const int nb = int(std::min<std::uint32_t>(Bvh::kBins, std::max<std::uint32_t>(4, n / 2)));
+    for (int a = 0; a < 3; ++a) k[a] = k[a] * float(nb) / float(Bvh::kBins);
+    Box bins[3][Bvh::kBins], bins2[3][Bvh::kBins];
+    std::uint32_t counts[3][Bvh::kBins], counts2[3][Bvh::kBins];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < nb; ++b) {
+        bins[a][b] = bins2[a][b] = Box::empty();
+        counts[a][b] = counts2[a][b] = 0;
+      }
+    std::uint32_t i = begin;
+    for (; i + 1 < end; i += 2) {
+      const PrimRef& p = prims[i];
+      const PrimRef& q = prims[i + 1];
+      const v4i b = bin_of(p, cbox.lo, k, nb), c = bin_of(q, cbox.lo, k, nb);
+      for (int a = 0; a < 3; ++a) {
+        bins[a][b[a]].grow(p.lo, p.hi);
+        ++counts[a][b[a]];
+        bins2[a][c[a]].grow(q.lo, q.hi);
+        ++counts2[a][c[a]];
+      }
+    }
+    if (i < end) {
+      const v4i b = bin_of(prims[i], cbox.lo, k, nb);
       for (int a = 0; a < 3; ++a) {
         bins[a][b[a]].grow(prims[i].lo, prims[i].hi);
         ++counts[a][b[a]];
       }
     }
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < nb; ++b) {
+        bins[a][b].grow(bins2[a][b].lo, bins2[a][b].hi);
+        counts[a][b] += counts2[a][b];
+      }
     int best_axis = -1, best_bin = -1;
     double best_cost = INFINITY;
     for (int a = 0; a < 3; ++a) {
       if (k[a] == 0) continue;
       double right_area[Bvh::kBins];
       std::uint32_t right_count[Bvh::kBins];
-      Box acc;
+      Box acc = Box::empty();
       std::uint32_t cnt = 0;
-      for (int b = Bvh::kBins - 1; b > 0; --b) {
+      for (int b = nb - 1; b > 0; --b) {
         acc.grow(bins[a][b].lo, bins[a][b].hi);
         cnt += counts[a][b];
         right_area[b] = acc.area();
         right_count[b] = cnt;
       }
-      Box left;
+      Box left = Box::empty();
       std::uint32_t lcnt = 0;
-      for (int b = 0; b < Bvh::kBins - 1; ++b) {
+      for (int b = 0; b < nb - 1; ++b) {
         left.grow(bins[a][b].lo, bins[a][b].hi);
         lcnt += counts[a][b];
         if (lcnt == 0 || right_count[b + 1] == 0) continue;
@@ -134,33 +168,49 @@ struct Builder {
         }
       }
     }
-    std::uint32_t mid;
-    if (best_axis < 0 || depth >= kMaxSahDepth) {
+    // Partition, gathering both sides' bounds on the way (no extra pass).
+    std::uint32_t mid = begin;
+    Box lbox = Box::empty(), lcbox = lbox, rbox = lbox, rcbox = lbox;
+    if (best_axis >= 0 && depth < kMaxSahDepth) {
+      std::uint32_t j = end;
+      while (mid < j) {
+        const PrimRef& p = prims[mid];
+        const v4f c = p.lo + p.hi;
+        if (bin_of(p, cbox.lo, k, nb)[best_axis] <= best_bin) {
+          lbox.grow(p.lo, p.hi);
+          lcbox.grow(c, c);
+          ++mid;
+        } else {
+          rbox.grow(p.lo, p.hi);
+          rcbox.grow(c, c);
+          std::swap(prims[mid], prims[--j]);
+        }
+      }
+    }
+    if (mid == begin || mid == end) {
       // All centroids coincide, or a degenerate SAH chain got deep: halve
       // the range, which bounds the remaining depth by log2(n).
       mid = begin + n / 2;
       best_axis = 0;
-    } else {
-      auto it = std::partition(prims.begin() + begin, prims.begin() + end,
-                               [&](const PrimRef& p) { return bin_of(p, cbox.lo, k)[best_axis] <= best_bin; });
-      mid = std::uint32_t(it - prims.begin());
-      if (mid == begin || mid == end) mid = begin + n / 2;
+      lbox = lcbox = rbox = rcbox = Box::empty();
+      bounds(begin, mid, lbox, lcbox);
+      bounds(mid, end, rbox, rcbox);
     }
     std::uint32_t right;
     if (threads > 1 && n >= kMinParallel) {
       // The right subtree on another thread into its own nodes, appended
       // after the left one with its child indices shifted.
       Builder other{prims, pad, {}};
-      std::thread th([&] { other.build(mid, end, depth + 1, threads / 2); });
-      build(begin, mid, depth + 1, threads - threads / 2);
+      std::thread th([&] { other.build(mid, end, rbox, rcbox, depth + 1, threads / 2); });
+      build(begin, mid, lbox, lcbox, depth + 1, threads - threads / 2);
       th.join();
       right = std::uint32_t(nodes.size());
       for (BinNode& b : other.nodes)
         if (b.count == 0) b.index += right;
       nodes.insert(nodes.end(), other.nodes.begin(), other.nodes.end());
     } else {
-      build(begin, mid, depth + 1, 1);
-      right = build(mid, end, depth + 1, 1);
+      build(begin, mid, lbox, lcbox, depth + 1, 1);
+      right = build(mid, end, rbox, rcbox, depth + 1, 1);
     }
     nodes[me].index = right;
     nodes[me].count = 0;
@@ -252,7 +302,9 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
   if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
   Builder b{prims, pad, {}};
   b.nodes.reserve(n / 2 + 1);
-  b.build(0, std::uint32_t(n), 0, threads);
+  Box box = Box::empty(), cbox = box;
+  b.bounds(0, std::uint32_t(n), box, cbox);
+  b.build(0, std::uint32_t(n), box, cbox, 0, threads);
   std::vector<std::uint32_t> order(n);
   for (std::size_t i = 0; i < n; ++i) order[i] = prims[i].id();
   bvh.nodes.reserve(b.nodes.size() / 7 + 1);
