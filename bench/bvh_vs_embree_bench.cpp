@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "accel/bvh.h"
@@ -211,6 +212,29 @@ int main(int argc, char** argv) {
   std::printf("primary embree %.2f Mrays/s  ours %.2f  ratio %.3f  hits %ld / %ld\n", ep, op, op / ep, he, ho);
   std::printf("shadow  embree %.2f Mrays/s  ours %.2f  ratio %.3f  occluded %ld / %ld of %zu\n", esr, osr, osr / esr,
               se, so, shadow.size());
+  // Two threads on alternate primary rays: rays per second of each
+  // thread's own CPU time, summed (a shared machine cannot give two idle
+  // cores; this shows whether the threads slow each other down).
+  {
+    const std::size_t half = primary.size() / 2;
+    double cpu[2] = {0, 0};
+    std::vector<double> rates2;
+    for (int k = 0; k < reps; ++k) {
+      auto run = [&](int w) {
+        const double s = cpu_now();
+        long h = 0;
+        // Alternate rays, so both threads get the same mix of hits and misses.
+        for (std::size_t i = std::size_t(w); i < 2 * half; i += 2) h += tracer.intersect(primary[i]).has_value();
+        cpu[w] = cpu_now() - s + 0 * double(h);
+      };
+      std::thread t1(run, 1);
+      run(0);
+      t1.join();
+      rates2.push_back((double(half) / cpu[0] + double(half) / cpu[1]) / 1e6);
+    }
+    std::printf("primary, 2 threads: ours %.2f Mrays/s (sum over threads of rays per CPU second) = %.2f x 1 thread\n",
+                median(rates2), median(rates2) / op);
+  }
   std::printf("away    embree %.2f Mrays/s  ours %.2f  ratio %.3f  (rays missing everything)\n", ea, oa, oa / ea);
   rtcReleaseScene(es);
   rtcReleaseDevice(dev);
