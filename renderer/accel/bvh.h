@@ -79,6 +79,11 @@ struct Bvh {
 
 namespace bvh_detail {
 
+// 32-byte vectors are passed only between always-inline helpers, so the
+// ABI note (how they would be passed without AVX) does not apply.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 // 8 lanes: one AVX register where the caller is compiled for AVX2 (the
 // tracer's AVX2 entry points), two SSE registers otherwise.
 typedef float v8f __attribute__((vector_size(32)));
@@ -187,6 +192,8 @@ template <class T>
   const v8f far_up = tf + vabs(tf) * slack;
   return movemask(tnear <= far_up);
 }
+
+#pragma GCC diagnostic pop
 
 }  // namespace bvh_detail
 

@@ -13,6 +13,10 @@
 
 namespace ra::moller_simd {
 
+// 32-byte vectors (4 doubles) pass only between always-inline helpers.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 // 4 triangles, structure of arrays: a[axis][lane] and the edges e1 = b - a,
 // e2 = c - a rounded to T once here, which are the very values moller::hit
 // computes from the same T vertices on every call. Unused lanes are all zero
@@ -85,5 +89,7 @@ template <class T>
   __builtin_memcpy(out.b1, &u, sizeof u);
   __builtin_memcpy(out.b2, &v, sizeof v);
 }
+
+#pragma GCC diagnostic pop
 
 }  // namespace ra::moller_simd
