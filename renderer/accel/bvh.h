@@ -187,9 +187,13 @@ template <class T>
     tnear = tn;
     return movemask(tn <= tf * splat(1 + 4 * Bvh::kRelSlack));
   }
-  const v8f slack = splat(Bvh::kRelSlack);
-  tnear = tn - vabs(tn) * slack;
-  const v8f far_up = tf + vabs(tf) * slack;
+  // The slack is capped at FLT_MAX: an entry or exit t that overflowed to
+  // +-inf stays infinite instead of becoming inf - inf = NaN (the kernel
+  // can report a hit at t = inf in float when the true t overflows).
+  const v8f slack = splat(Bvh::kRelSlack), cap = splat(std::numeric_limits<float>::max());
+  const v8f sn = vabs(tn) * slack, sf = vabs(tf) * slack;
+  tnear = tn - (sn < cap ? sn : cap);
+  const v8f far_up = tf + (sf < cap ? sf : cap);
   return movemask(tnear <= far_up);
 }
 

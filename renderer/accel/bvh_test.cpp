@@ -70,6 +70,10 @@ void compare(const Vec3d& at, double far, std::uint64_t seed, int* hits) {
       if (i % 7 == 3) r.d = r.d * 1e-20;
       if (i % 7 == 4) r.d = r.d * 1e20;
       if (i % 11 == 7) r.tmin = -0.5;  // a window reaching behind the origin
+      // Directions whose 1/d float cannot hold (the visit-every-leaf path),
+      // or whose t overflows float (a float kernel's hit at t = inf).
+      if (i % 13 == 6) r.d = r.d * 1e-40;
+      if (i % 13 == 8) r.d = r.d * 1e40;
       const auto a = none.intersect(r);
       if (i % 6 == 5 && a) r.tmax = a->t;  // a window ending at the hit
       const auto b = bvh.intersect(r), c = bvh_sse2.intersect(r);
