@@ -13,7 +13,7 @@
 #include <random>
 
 #include "bump.h"
-#include "bvh.h"
+#include "accel/bvh.h"
 #include "camera.h"
 #include "image.h"
 #include "methods/areas.h"
@@ -554,8 +554,11 @@ TEST(Accel, NoneSphereAndBvhGiveBitIdenticalImages) {
       const Image sphere = render(scene, o);
       o.accel = Accel::bvh;
       const Image bvh = render(scene, o);
+      o.simd = false;  // the baseline SSE2 paths (AVX2 ones above, where the CPU has it)
+      const Image bvh_sse2 = render(scene, o);
       EXPECT_EQ(none.rgb, sphere.rgb) << m.name << (dbl ? " double" : " float");
       EXPECT_EQ(none.rgb, bvh.rgb) << m.name << (dbl ? " double" : " float");
+      EXPECT_EQ(none.rgb, bvh_sse2.rgb) << m.name << (dbl ? " double" : " float");
     }
   }
 }
@@ -747,17 +750,27 @@ TEST(Accel, BvhLeavesHoldAtMostFourTrianglesAndEveryTriangleOnce) {
   }
   const Bvh b = Bvh::build(lo, hi, 0);
   std::vector<int> seen(lo.size(), 0);
+  int leaves = 0;
   for (const auto& n : b.nodes)
-    if (n.count > 0) {
-      EXPECT_LE(n.count, Bvh::kMaxLeaf);
-      for (unsigned s = n.index; s < n.index + n.count; ++s) {
+    for (int i = 0; i < Bvh::kWidth; ++i) {
+      if (!Bvh::is_leaf(n.child[i])) continue;
+      ++leaves;
+      const unsigned first = Bvh::leaf_first(n.child[i]), count = Bvh::leaf_count(n.child[i]);
+      EXPECT_EQ(first % 4, 0u);
+      EXPECT_LE(count, unsigned(Bvh::kMaxLeaf));
+      for (unsigned s = first; s < first + 4; ++s) {
+        if (s >= first + count) {
+          EXPECT_EQ(b.order[s], Bvh::kNoTriangle);
+          continue;
+        }
         ++seen[b.order[s]];
         for (int a = 0; a < 3; ++a) {
-          EXPECT_LE(n.lo[a], lo[b.order[s]][a]);
-          EXPECT_GE(n.hi[a], hi[b.order[s]][a]);
+          EXPECT_LE(n.lo[a][i], lo[b.order[s]][a]);
+          EXPECT_GE(n.hi[a][i], hi[b.order[s]][a]);
         }
       }
     }
+  EXPECT_EQ(std::size_t(leaves) * 4, b.order.size());
   for (int c : seen) EXPECT_EQ(c, 1);
 }
 

@@ -13,9 +13,11 @@
 #include <type_traits>
 
 #include "bump.h"
-#include "bvh.h"
+#include "accel/bounding_sphere.h"
+#include "accel/bvh.h"
 #include "camera.h"
 #include "errors.h"
+#include "methods/moller_simd.h"
 #include "pov_mesh.h"
 #include "registry.h"
 #include "texture.h"
@@ -45,31 +47,21 @@ constexpr double kMinCosIncidence = 1e-10;
 // A mesh ready for tracing at precision T: each triangle's prepared bytes
 // for the chosen method, its unit geometric normal, and the bounding sphere
 // of document 002's optimisation. With --accel bvh the prepared bytes are
-// stored in the BVH's slot order (bvh.order maps a slot to its triangle).
+// stored in the BVH's slot order (bvh.order maps a slot to its triangle), and
+// for moller its leaves also as 4-lane blocks (methods/moller_simd.h).
 template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
   std::size_t stride = 0;
   std::vector<unsigned char> pre;  // per triangle, or per BVH slot
   Bvh bvh;                         // --accel bvh only
+  std::vector<moller_simd::Tri4<T>> tri4;  // per BVH leaf, moller only
   std::vector<Vec3d> gnormal;        // per triangle, (B-A)x(C-A) normalised
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
   double bs_radius = 0;
   bool cull = false;  // --cull, and the mesh is closed (cull_unsafe_reason)
 };
-
-// Does the segment [tmin, tmax] of the ray pass through the solid ball?
-// Conservative (inflated by a relative 1e-6) so that it never rejects a mesh
-// the ray could hit.
-bool segment_meets_ball(const Ray<double>& r, const Vec3d& c, double radius) {
-  const double dd = dot(r.d, r.d);
-  double t = dot(c - r.o, r.d) / dd;
-  t = std::clamp(t, r.tmin, std::isfinite(r.tmax) ? r.tmax : std::max(t, r.tmin));
-  const Vec3d q = r.o + r.d * t - c;
-  const double rr = radius * (1 + 1e-6) + 1e-12 * length(c);
-  return dot(q, q) <= rr * rr;
-}
 
 // Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
 // object, then the lower triangle, so the answer does not depend on the order
@@ -107,6 +99,7 @@ struct Tracer::Impl {
       throw InputError("unknown sphere method \"" + o.sphere_method +
                        "\"; valid: " + method_names(Kind::sphere));
     pln_method = &default_method(Kind::plane);
+    avx2 = o.simd && __builtin_cpu_supports("avx2");
     if (o.samples_per_axis < 1 || o.samples_per_axis > 16)
       throw InputError("samples per axis must be between 1 and 16");
     mesh_index.assign(s.objects.size(), -1);
@@ -188,37 +181,22 @@ struct Tracer::Impl {
       hi[i] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
     }
     const double size = std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
-    m.bvh = Bvh::build(lo, hi, 1e-5 * size);
-    std::vector<unsigned char> pre(m.pre.size());
-    for (std::size_t s = 0; s < n; ++s)
-      std::memcpy(pre.data() + s * m.stride, m.pre.data() + std::size_t(m.bvh.order[s]) * m.stride, m.stride);
+    m.bvh = Bvh::build(lo, hi, 1e-5 * size, opt.threads);
+    const std::size_t slots = m.bvh.order.size();
+    std::vector<unsigned char> pre(slots * m.stride, 0);
+    for (std::size_t s = 0; s < slots; ++s)
+      if (m.bvh.order[s] != Bvh::kNoTriangle)
+        std::memcpy(pre.data() + s * m.stride, m.pre.data() + std::size_t(m.bvh.order[s]) * m.stride, m.stride);
     m.pre = std::move(pre);
-  }
-
-  // Visits the BVH leaves the ray's window meets, near child first; `leaf`
-  // gets each slot and returns true to stop. `tmax` is re-read at every node
-  // (closest-hit shrinks it).
-  template <class T, class Leaf>
-  static void traverse(const Bvh& bvh, const Ray<T>& r, const T& tmax, Leaf&& leaf) {
-    if (bvh.nodes.empty()) return;
-    const Vec3d o(r.o), d(r.d);
-    const Vec3d inv{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
-    std::uint32_t stack[Bvh::kMaxDepth + 2];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const std::uint32_t ni = stack[--top];
-      const BvhNode& node = bvh.nodes[ni];
-      if (!ray_meets_box(node, o, inv, d, double(r.tmin), double(tmax))) continue;
-      if (node.count > 0) {
-        for (std::uint32_t s = node.index; s < node.index + node.count; ++s)
-          if (leaf(s)) return;
-        continue;
+    // moller has a 4-lane form that answers bit for bit as the scalar one.
+    if (tri_method->name == "moller") {
+      m.tri4.assign(slots / 4, moller_simd::Tri4<T>{});
+      for (std::size_t s = 0; s < slots; ++s) {
+        if (m.bvh.order[s] == Bvh::kNoTriangle) continue;
+        const auto& tri = set.triangles[m.bvh.order[s]];
+        m.tri4[s / 4].set(int(s % 4), Vec3<T>(set.positions[tri.v[0]]), Vec3<T>(set.positions[tri.v[1]]),
+                          Vec3<T>(set.positions[tri.v[2]]));
       }
-      std::uint32_t near_child = ni + 1, far_child = node.index;
-      if (d[node.axis] < 0) std::swap(near_child, far_child);
-      stack[top++] = far_child;
-      stack[top++] = near_child;
     }
   }
 
@@ -228,14 +206,15 @@ struct Tracer::Impl {
   }
 
   // Closest hit at precision T. The ray arrives in double (shading is done in
-  // double); the kernels see it converted to T.
+  // double); the kernels see it converted to T. Inlined into closest() and
+  // closest_avx2(), which compile it for baseline x86-64 and for AVX2.
   template <class T>
-  std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1) const {
+  [[gnu::always_inline]] inline std::optional<SceneHit> closest_impl(const Ray<double>& rd, int only = -1) const {
     const Ray<T> r(rd);
     SceneHit best;
     best.t = std::numeric_limits<double>::infinity();
     Ray<T> window = r;
-    auto consider = [&](double t, int obj, int prim, double b1, double b2) {
+    auto consider = [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
       if (nearer(t, obj, prim, best)) {
         best = {t, obj, prim, b1, b2};
         window.tmax = T(t);
@@ -264,9 +243,22 @@ struct Tracer::Impl {
             break;
           }
           if (opt.accel == Accel::bvh) {
-            traverse(m.bvh, window, window.tmax, [&](std::uint32_t slot) {
-              if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
-                consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
+            if (!m.tri4.empty()) {
+              traverse<true>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+                moller_simd::Hit4<T> h;
+                moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
+                for (int hits = h.hits; hits; hits &= hits - 1) {
+                  const int l = __builtin_ctz(unsigned(hits));
+                  consider(double(h.t[l]), int(oi), int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
+                }
+                return false;
+              });
+              break;
+            }
+            traverse<true>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+              for (std::uint32_t slot = first; slot < first + count; ++slot)
+                if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
+                  consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
               return false;
             });
             break;
@@ -316,8 +308,9 @@ struct Tracer::Impl {
     };
     if (opt.accel == Accel::bvh) {
       const Ray<double> all{r.o, r.d, 0.0, std::numeric_limits<double>::infinity()};
-      traverse(m.bvh, all, all.tmax, [&](std::uint32_t slot) {
-        test(int(m.bvh.order[slot]));
+      // Every leaf the ray's boxes reach (any-hit order; sorted below).
+      traverse<false>(m.bvh, all.o, all.d, all.tmin, all.tmax, [&](std::uint32_t first, std::uint32_t count) {
+        for (std::uint32_t slot = first; slot < first + count; ++slot) test(int(m.bvh.order[slot]));
         return false;
       });
     } else {
@@ -347,9 +340,9 @@ struct Tracer::Impl {
     return entry;
   }
 
-  // Is anything in the ray's window? (shadow rays)
+  // Is anything in the ray's window? (shadow rays) Inlined as closest_impl.
   template <class T>
-  bool occluded(const Ray<T>& r) const {
+  [[gnu::always_inline]] inline bool occluded_impl(const Ray<T>& r) const {
     for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
       const Object& o = scene.objects[oi];
       switch (o.kind) {
@@ -369,9 +362,19 @@ struct Tracer::Impl {
           }
           if (opt.accel == Accel::bvh) {
             bool hit = false;
-            traverse(m.bvh, r, r.tmax, [&](std::uint32_t slot) {
-              return hit = k.any_pre(r, m.pre.data() + slot * m.stride, m.cull);
-            });
+            if (!m.tri4.empty()) {
+              traverse<false>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+                moller_simd::Hit4<T> h;
+                moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
+                return hit = h.hits != 0;
+              });
+            } else {
+              traverse<false>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+                for (std::uint32_t slot = first; slot < first + count; ++slot)
+                  if (k.any_pre(r, m.pre.data() + slot * m.stride, m.cull)) return hit = true;
+                return false;
+              });
+            }
             if (hit) return true;
             break;
           }
@@ -387,6 +390,30 @@ struct Tracer::Impl {
     }
     return false;
   }
+
+  // The SIMD paths chosen at run time: the BVH's 8-wide box tests and the
+  // double leaves are one AVX register each where the CPU has AVX2, two SSE
+  // registers otherwise; the answers are the same bits either way.
+  bool avx2 = false;
+
+  // `only` >= 0 restricts the search to that one object (POV-Ray's shadow
+  // cache asks about the object that shadowed the previous pixel).
+  template <class T>
+  std::optional<SceneHit> closest_base(const Ray<double>& rd, int only) const { return closest_impl<T>(rd, only); }
+  template <class T>
+  [[gnu::target("avx2")]] std::optional<SceneHit> closest_avx2(const Ray<double>& rd, int only) const {
+    return closest_impl<T>(rd, only);
+  }
+  template <class T>
+  std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1) const {
+    return avx2 ? closest_avx2<T>(rd, only) : closest_base<T>(rd, only);
+  }
+  template <class T>
+  bool occluded_base(const Ray<T>& r) const { return occluded_impl<T>(r); }
+  template <class T>
+  [[gnu::target("avx2")]] bool occluded_avx2(const Ray<T>& r) const { return occluded_impl<T>(r); }
+  template <class T>
+  bool occluded(const Ray<T>& r) const { return avx2 ? occluded_avx2<T>(r) : occluded_base<T>(r); }
 
   std::optional<SceneHit> intersect(const Ray<double>& r) const {
     return opt.use_double ? closest<double>(r) : closest<float>(r);

@@ -26,6 +26,9 @@ struct RenderOptions {
   int threads = 0;          // 0: all cores
   int samples_per_axis = 1; // n x n samples per pixel, averaged
   bool progress = true;     // a progress line on a terminal (stderr)
+  // Use AVX2 where the CPU has it (false: the baseline x86-64 SSE2 paths;
+  // both give the same bits, which the Accel tests check).
+  bool simd = true;
   // Shade a mesh hit where POV-Ray 3.7's mesh2 puts it (renderer/pov_mesh.h):
   // the point O + t D with t from the triangle's float32 plane, and normals
   // and UVs interpolated there through POV's float32 Perp vector. Which
@@ -86,7 +89,8 @@ class Tracer {
   Color trace(const Ray<double>& ray) const;
   // The closest hit of a ray, if any (the ray's own window applies).
   std::optional<SceneHit> intersect(const Ray<double>& ray) const;
-  // Is anything in the ray's window? (any hit: what shadow rays ask)
+  // Is anything in the ray's window? (what shadow rays ask), in the chosen
+  // precision.
   bool occluded(const Ray<double>& ray) const;
   // The surface where a ray first hits: point, geometric normal and the
   // shading normal as lighting sees it before the face-forward flip
