@@ -22,42 +22,6 @@
 namespace rb {
 namespace {
 
-struct Process {
-  double wall_s = 0, cpu_s = 0;
-  int code = -1;
-};
-
-// Runs argv in `dir`, stdout and stderr to files; wall and CPU seconds
-// (user + system, from wait4) of the child.
-Process run_process(const fs::path& dir, const std::vector<std::string>& argv, const fs::path& out,
-                    const fs::path& err) {
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  const auto t0 = now();
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    const int in = open("/dev/null", O_RDONLY);
-    if (o < 0 || e < 0 || in < 0 || chdir(dir.c_str()) != 0) _exit(126);
-    dup2(in, 0);
-    dup2(o, 1);
-    dup2(e, 2);
-    execv(args[0], args.data());
-    _exit(127);
-  }
-  int status = 0;
-  rusage ru{};
-  while (wait4(pid, &status, 0, &ru) < 0)
-    if (errno != EINTR) throw std::runtime_error("wait4 failed");
-  Process p;
-  p.wall_s = seconds_since(t0);
-  p.cpu_s = double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
-  p.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return p;
-}
 
 std::string read_text(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -140,11 +104,11 @@ void bm_pov(benchmark::State& state, const Rung* rung, int threads) {
     benchmark::DoNotOptimize(tracer.render());
     ours_trace += seconds_since(t0);
     // Ours as a process, the way a user runs it.
-    const Process op = run_process(work.path, ours_argv, work.path / "ours.out", work.path / "ours.err");
+    const ra::ProcessRun op = ra::run_process(work.path, ours_argv, work.path / "ours.out", work.path / "ours.err");
     if (op.code != 0) throw std::runtime_error("rayaudit render failed: " + read_text(work.path / "ours.err"));
     ours_proc += op.wall_s;
     // POV-Ray.
-    const Process pp = run_process(work.path, pov_argv, work.path / "povray.out", work.path / "povray.err");
+    const ra::ProcessRun pp = ra::run_process(work.path, pov_argv, work.path / "povray.out", work.path / "povray.err");
     const std::string log = read_text(work.path / "povray.err");
     if (pp.code != 0) throw std::runtime_error("POV-Ray failed (exit " + std::to_string(pp.code) + ")");
     const PovTime parse = pov_time(log, "Parse Time"), bound = pov_time(log, "Bounding Time"),

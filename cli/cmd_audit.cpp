@@ -22,6 +22,8 @@
 
 namespace {
 
+using ra::cli::split_list;
+
 using namespace ra::audit;
 
 // Memory does not grow with --rays (chunks are numbered, not listed), so the
@@ -50,20 +52,6 @@ std::string parse_shard(const std::string& text, Shard& out) {
       out.k < 1 || out.k > out.n || out.n > kMaxShards)
     return "'" + text + "' is not K/N with 1 <= K <= N <= " + std::to_string(kMaxShards) + " (e.g. 2/8: the second of eight)";
   return {};
-}
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char ch : s + ",") {
-    if (ch == ',') {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else if (ch != ' ') {
-      cur += ch;
-    }
-  }
-  return out;
 }
 
 std::vector<const ra::Method*> chosen_methods(const std::string& list) {

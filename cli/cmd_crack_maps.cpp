@@ -15,6 +15,8 @@
 
 namespace {
 
+using ra::cli::split_list;
+
 struct Args {
   std::string out;
   std::vector<std::string> meshes;
@@ -22,23 +24,9 @@ struct Args {
   int size = 96, threads = 0;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char ch : s + ",") {
-    if (ch == ',') {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else if (ch != ' ') {
-      cur += ch;
-    }
-  }
-  return out;
-}
-
 std::vector<double> parse_offsets(const std::string& list) {
   std::vector<double> out;
-  for (const auto& s : split(list)) {
+  for (const auto& s : split_list(list)) {
     std::size_t used = 0;
     double v = 0;
     try {
@@ -84,7 +72,7 @@ void run(const Args& a) {
   opt.size = a.size;
   opt.threads = a.threads;
   opt.offsets = parse_offsets(a.offsets);
-  opt.methods = split(a.methods);
+  opt.methods = split_list(a.methods);
   opt.progress = progress_count();
   const std::filesystem::path dir(a.out);
   if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))

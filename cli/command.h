@@ -3,6 +3,7 @@
 #pragma once
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace ra::cli {
@@ -18,6 +19,22 @@ struct Command {
 };
 
 std::vector<Command>& commands();
+
+// "a, b,,c" -> {"a", "b", "c"}: the comma-separated lists of options such
+// as --methods, --families and --offsets (spaces and empty items dropped).
+inline std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char ch : s + ",") {
+    if (ch == ',') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else if (ch != ' ') {
+      cur += ch;
+    }
+  }
+  return out;
+}
 
 struct Registrar {
   Registrar(int order, std::function<void(CLI::App&)> setup) {

@@ -1,10 +1,14 @@
 #include "pov_runner.h"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
 #include <cstdlib>
+#include <stdexcept>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -35,12 +39,15 @@ struct WorkDir {
   }
 };
 
-// Runs argv in `dir` with stdout and stderr to files there; returns the
-// exit status (or -1 when it did not exit normally).
-int run_in(const fs::path& dir, const std::vector<std::string>& argv, const fs::path& out, const fs::path& err) {
+
+}  // namespace
+
+ProcessRun run_process(const fs::path& dir, const std::vector<std::string>& argv, const fs::path& out,
+                       const fs::path& err) {
   std::vector<char*> args;
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
@@ -55,12 +62,15 @@ int run_in(const fs::path& dir, const std::vector<std::string>& argv, const fs::
     _exit(127);
   }
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  rusage ru{};
+  ProcessRun run;
+  while (wait4(pid, &status, 0, &ru) < 0)
+    if (errno != EINTR) return run;
+  run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run.cpu_s = double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
 }
-
-}  // namespace
 
 fs::path find_povray() {
   if (const char* env = std::getenv("RAYAUDIT_POVRAY"); env && *env) {
@@ -112,7 +122,7 @@ PovRun run_povray(const PovExport& ex, int width, int height, const PovRunOption
                                          "+W" + std::to_string(width),
                                          "+H" + std::to_string(height),
                                          "+WT1"};
-  const int code = run_in(work.path, argv, work.path / "povray.out", work.path / "povray.err");
+  const int code = run_process(work.path, argv, work.path / "povray.out", work.path / "povray.err").code;
   PovRun run;
   run.log = read_text(work.path / "povray.err");
   if (code != 0 || !fs::exists(work.path / "out.png")) {

@@ -7,6 +7,7 @@
 #pragma once
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "image.h"
 #include "scene.h"
@@ -24,6 +25,18 @@ struct PovRun {
   std::filesystem::path dir;  // the working directory if kept, else empty
   std::string log;            // POV-Ray's stderr
 };
+
+// A finished child process: its exit code (-1 when it did not exit
+// normally) and the wall and CPU (user + system) seconds it took.
+struct ProcessRun {
+  int code = -1;
+  double wall_s = 0, cpu_s = 0;
+};
+
+// Runs argv (argv[0] a path) in `dir`, stdin from /dev/null, stdout and
+// stderr to files. Used for POV-Ray here and by the benchmark's POV-Ray peer.
+ProcessRun run_process(const std::filesystem::path& dir, const std::vector<std::string>& argv,
+                       const std::filesystem::path& out, const std::filesystem::path& err);
 
 // The povray program: $RAYAUDIT_POVRAY, else `povray` on the PATH. Throws
 // InputError saying how to install it when there is none.
