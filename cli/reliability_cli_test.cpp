@@ -184,3 +184,18 @@ TEST(ReliabilityCli, ConvertRefusesANanCoordinate) {
 }
 
 }  // namespace
+
+namespace {
+
+// A UTF-8 byte-order mark (as spreadsheets write) is not part of the first
+// column's name: it used to read as "missing column 'ox'".
+TEST(ReliabilityCli, CasesCsvWithAUtf8BomIsRead) {
+  const fs::path csv = scratch("bom.csv"), json = scratch("bom.json");
+  std::ofstream(csv) << "\xEF\xBB\xBFox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
+                        "0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n";
+  const auto r = run_rayaudit("audit --cases " + csv.string() + " --methods moller --json " + json.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(json));
+}
+
+}  // namespace

@@ -155,12 +155,14 @@ std::size_t min_row_bytes(const PlyElement& el, int format) {
   return std::max<std::size_t>(n, 1);  // a row without properties is still a line (or a byte)
 }
 
-void check_ply_counts(const std::vector<PlyElement>& elements, int format, std::size_t data_bytes, Tokens& t) {
-  std::uint64_t need = 0;
+// Every row takes at least a byte: more rows than bytes is refused at the
+// header. Fewer, but still more than the data holds, fail where the data
+// ends (with its line, or its byte offset in binary).
+void check_ply_counts(const std::vector<PlyElement>& elements, std::size_t data_bytes, Tokens& t) {
+  std::uint64_t rows = 0;
   for (const auto& el : elements) {
-    const std::size_t row = min_row_bytes(el, format);
-    need += std::uint64_t(el.count) * row;
-    if (need > data_bytes + (format == 0))  // the last ASCII line may lack its newline
+    rows += std::uint64_t(el.count);
+    if (rows > data_bytes + 1)  // the last ASCII line may lack its newline
       t.fail("element '" + el.name + "' declares " + std::to_string(el.count) + " rows, more than the " +
              std::to_string(data_bytes) + " bytes after the header can hold");
   }
@@ -213,7 +215,7 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
   if (format < 0) t.fail("no format line");
   // Counts are trusted only as far as the bytes after the header can hold
   // them (a count of 2^31 would otherwise reserve gigabytes first).
-  check_ply_counts(elements, format, std::size_t(t.e - t.p), t);
+  check_ply_counts(elements, std::size_t(t.e - t.p), t);
   PolyMesh m;
   m.face_start.push_back(0);
   BinReader br{reinterpret_cast<const unsigned char*>(t.p), reinterpret_cast<const unsigned char*>(bytes.data()),
@@ -231,7 +233,8 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
     }
     if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) t.fail("vertex element without x, y, z");
     if (is_face && ilist < 0) t.fail("face element without vertex_indices");
-    if (is_vertex) m.positions.reserve(size_t(el.count));
+    // Reserve no more than the data can hold (a count alone is not trusted).
+    if (is_vertex) m.positions.reserve(std::min(size_t(el.count), size_t(br.e - br.p) / min_row_bytes(el, format) + 1));
     for (long r = 0; r < el.count; ++r) {
       Vec3d pos;
       for (size_t i = 0; i < el.props.size(); ++i) {
@@ -304,15 +307,16 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
   const long nv = t.number<long>("vertex count"), nf = t.number<long>("face count");
   t.number<long>("edge count");
   if (nv < 0 || nf < 0 || nv > (1L << 31) || nf > (1L << 31)) t.fail("counts out of range");
-  // A vertex line takes at least 5 bytes ("0 0 0"), a face more: counts the
-  // file cannot hold are refused before anything is reserved.
+  // Each vertex or face takes more than a byte: counts beyond the bytes that
+  // follow are refused at once, and no more is reserved than those hold
+  // ("0 0 0": 5 bytes a vertex). Truncated data fails at its line.
   const auto left = std::uint64_t(t.e - t.p);
-  if (std::uint64_t(nv) * 5 + std::uint64_t(nf) * 5 > left)
+  if (std::uint64_t(nv) + std::uint64_t(nf) > left)
     t.fail(std::to_string(nv) + " vertices and " + std::to_string(nf) + " faces cannot fit in the " +
            std::to_string(left) + " bytes that follow");
   t.next_line();
   PolyMesh m;
-  m.positions.reserve(size_t(nv));
+  m.positions.reserve(std::min(size_t(nv), size_t(left / 5) + 1));
   for (long i = 0; i < nv; ++i) {
     t.skip(true);
     Vec3d p;
