@@ -1,5 +1,6 @@
 #include "triangulate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -62,30 +63,57 @@ void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
     return orient2(q[size_t(prev[size_t(k)])], q[size_t(k)], q[size_t(next[size_t(k)])]) > 0;
   };
   // Only a corner that is not convex can lie inside an ear (Meisters), so
-  // only those are tested: a convex polygon costs O(n), not O(n^2).
+  // only those are tested, found through a uniform grid of about one cell
+  // each: a convex polygon costs O(n), a small ear O(1) tests.
   s.reflex.clear();
-  for (int i = 0; i < n; ++i)
+  double x0 = q[0][0], x1 = x0, y0 = q[0][1], y1 = y0;
+  for (int i = 0; i < n; ++i) {
+    x0 = std::min(x0, q[size_t(i)][0]), x1 = std::max(x1, q[size_t(i)][0]);
+    y0 = std::min(y0, q[size_t(i)][1]), y1 = std::max(y1, q[size_t(i)][1]);
     if (!convex(i)) s.reflex.push_back(i);
+  }
+  const int g = std::max(1, int(std::sqrt(double(s.reflex.size()))));
+  const double sx = x1 > x0 ? g / (x1 - x0) : 0, sy = y1 > y0 ? g / (y1 - y0) : 0;
+  auto cell = [&](double v, double lo, double scale) {
+    const double c = (v - lo) * scale;
+    return c <= 0 ? 0 : (c >= g - 1 ? g - 1 : int(c));  // also catches NaN (as 0)
+  };
+  s.cell_start.assign(size_t(g) * size_t(g) + 1, 0);
+  for (int w : s.reflex) ++s.cell_start[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx)) + 1];
+  for (size_t k = 1; k < s.cell_start.size(); ++k) s.cell_start[k] += s.cell_start[k - 1];
+  s.cell_items.resize(s.reflex.size());
+  {
+    std::vector<int> fill(s.cell_start.begin(), s.cell_start.end() - 1);
+    for (int w : s.reflex)
+      s.cell_items[size_t(fill[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx))]++)] = w;
+  }
   // Work limit (see triangulate.h): beyond it the rest is cut as a fan.
   long budget = kEarClipWorkPerCorner * long(n);
   int m = n, cur = 1, since_cut = 0;
-  std::size_t compact_at = std::size_t(n) / 2;
   while (m > 3) {
     const int a_i = prev[size_t(cur)], c_i = next[size_t(cur)];
     bool ear = false;
     if (budget > 0 && convex(cur)) {
       ear = true;
       const P2 &a = q[size_t(a_i)], &b = q[size_t(cur)], &c = q[size_t(c_i)];
-      for (const int w : s.reflex) {
-        --budget;
-        if (!s.alive[size_t(w)] || w == a_i || w == cur || w == c_i) continue;
-        const P2& p = q[size_t(w)];
-        if (p == a || p == b || p == c) continue;  // duplicated vertex
-        if (in_triangle(p, a, b, c)) {
-          ear = false;
-          break;
+      const int cx0 = cell(std::min({a[0], b[0], c[0]}), x0, sx), cx1 = cell(std::max({a[0], b[0], c[0]}), x0, sx);
+      const int cy0 = cell(std::min({a[1], b[1], c[1]}), y0, sy), cy1 = cell(std::max({a[1], b[1], c[1]}), y0, sy);
+      for (int cy = cy0; cy <= cy1 && ear; ++cy)
+        for (int cx = cx0; cx <= cx1 && ear; ++cx) {
+          const size_t k = size_t(cy) * size_t(g) + size_t(cx);
+          --budget;
+          for (int it = s.cell_start[k]; it < s.cell_start[k + 1]; ++it) {
+            const int w = s.cell_items[size_t(it)];
+            --budget;
+            if (!s.alive[size_t(w)] || w == a_i || w == cur || w == c_i) continue;
+            const P2& p = q[size_t(w)];
+            if (p == a || p == b || p == c) continue;  // duplicated vertex
+            if (in_triangle(p, a, b, c)) {
+              ear = false;
+              break;
+            }
+          }
         }
-      }
     }
     --budget;
     if (!ear && budget > 0 && since_cut < m) {  // try the next corner
@@ -102,11 +130,6 @@ void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
     --m;
     cur = c_i;
     since_cut = 0;
-    // Drop cut corners and corners that became convex from the list, now and then.
-    if (s.reflex.size() > 16 && std::size_t(m) < compact_at) {
-      std::erase_if(s.reflex, [&](int w) { return !s.alive[size_t(w)] || convex(w); });
-      compact_at = std::size_t(m) / 2;
-    }
   }
   out.push_back({prev[size_t(cur)], cur, next[size_t(cur)]});
 }

@@ -1,8 +1,8 @@
 // Ear clipping of one planar polygon (Meisters 1975, "Polygons have ears")
-// on a linked ring, testing only the corners that are not convex: O(n) for a
-// convex polygon, O(n r) with r reflex corners, and never more than
-// kEarClipWorkPerCorner steps a corner (see below). The polygon is projected
-// onto the coordinate plane most perpendicular to its Newell normal, in
+// on a linked ring, testing only the corners that are not convex, found
+// through a uniform grid: O(n) for a convex polygon, about O(n) for small
+// ears, and never more than kEarClipWorkPerCorner steps a corner (below).
+// The polygon is projected onto the coordinate plane most perpendicular to its Newell normal, in
 // coordinates relative to its first vertex so that large offsets do not eat
 // the precision (tinyobjloader #295 lost faces that way).
 // Guarantee: always n-2 triangles, each (a, b, c) listed in the polygon's
@@ -23,10 +23,10 @@
 
 namespace ra {
 
-inline constexpr long kEarClipWorkPerCorner = 1000;
+inline constexpr long kEarClipWorkPerCorner = 200;
 
 struct EarClipScratch {
-  std::vector<int> next, prev, reflex;
+  std::vector<int> next, prev, reflex, cell_start, cell_items;
   std::vector<char> alive;
   std::vector<std::array<double, 2>> q;
 };
