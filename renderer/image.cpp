@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <new>
 #include <string>
 
 #include "atomic_file.h"
@@ -146,7 +147,14 @@ std::vector<float> read_pixels(const std::filesystem::path& path, const char* wh
   width = int(w);
   height = int(h);
   channels = spec.nchannels;
-  std::vector<float> all(std::size_t(w * h) * std::size_t(channels));
+  std::vector<float> all;
+  try {
+    all.resize(std::size_t(w * h) * std::size_t(channels));
+  } catch (const std::bad_alloc&) {  // a legal size this machine cannot hold: still about this file
+    throw InputError(located(name, 0, what + std::string(" of ") + dims + " needs " +
+                                          std::to_string(w * h * std::uint64_t(channels) * 4 >> 20) +
+                                          " MB to read: not enough memory"));
+  }
   if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data()))
     throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + first_line(in->geterror())));
   in->close();

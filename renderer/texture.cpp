@@ -1,6 +1,8 @@
 #include "texture.h"
 
 #include <cmath>
+#include <new>
+#include <optional>
 
 #include "errors.h"
 #include "image.h"
@@ -66,10 +68,17 @@ Vec3d Texture::bilinear(double u, double v) const {
 Texture load_texture(const std::filesystem::path& file) {
   int w = 0, h = 0, nc = 0;
   const std::vector<float> all = read_pixels(file, "texture", w, h, nc);
-  Texture t(w, h);
+  std::optional<Texture> made;
+  try {
+    made.emplace(w, h);
+  } catch (const std::bad_alloc&) {
+    throw InputError(located(file.string(), 0, "texture of " + std::to_string(w) + "x" + std::to_string(h) +
+                                                   " pixels: not enough memory"));
+  }
+  Texture& t = *made;
   for (std::size_t i = 0, n = std::size_t(w) * h; i < n; ++i)
     for (int c = 0; c < 3; ++c) t.rgb[i * 3 + c] = all[i * nc + (nc >= 3 ? c : 0)];
-  return t;
+  return std::move(t);
 }
 
 const Texture& TextureCache::load(const std::filesystem::path& file) {
