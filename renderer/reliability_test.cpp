@@ -231,6 +231,19 @@ TEST(Triangulate, DegeneratePolygonOf60kCornersIsCutAsAFan) {
   EXPECT_EQ(out.size(), size_t(n - 2));
 }
 
+// Extents that overflow (1e308 - -1e308 = inf) must not break the grid of
+// reflex corners (the cell of NaN was undefined behaviour).
+TEST(Triangulate, OverflowingExtentsStillGiveNMinus2Triangles) {
+  const std::vector<Vec3d> p = {{-1e308, 0, 0}, {0, -1e308, 0}, {1e308, 0, 0}, {0, 1e-300, 0},
+                                {-1e307, 1e308, 0}, {-5e307, 1e307, 0}};
+  std::vector<std::array<int, 3>> out;
+  EarClipScratch s;
+  triangulate_polygon(p.data(), int(p.size()), out, s);
+  ASSERT_EQ(out.size(), p.size() - 2);
+  for (const auto& t : out)
+    for (int k : t) EXPECT_TRUE(k >= 0 && k < int(p.size()));
+}
+
 // A concave polygon still tiles exactly (a U: 8 corners, area 5).
 TEST(Triangulate, ConcaveUStillTilesExactly) {
   const std::vector<Vec3d> p = {{0, 0, 0}, {3, 0, 0}, {3, 2, 0}, {2, 2, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};

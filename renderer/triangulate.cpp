@@ -76,7 +76,7 @@ void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
   const double sx = x1 > x0 ? g / (x1 - x0) : 0, sy = y1 > y0 ? g / (y1 - y0) : 0;
   auto cell = [&](double v, double lo, double scale) {
     const double c = (v - lo) * scale;
-    return c <= 0 ? 0 : (c >= g - 1 ? g - 1 : int(c));  // also catches NaN (as 0)
+    return !(c > 0) ? 0 : (c >= g - 1 ? g - 1 : int(c));  // NaN (inf - inf) too: cell 0
   };
   s.cell_start.assign(size_t(g) * size_t(g) + 1, 0);
   for (int w : s.reflex) ++s.cell_start[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx)) + 1];
