@@ -119,9 +119,10 @@ TEST(Workers, AllWorkIsDoneWhateverTheThreadCount) {
   }
 }
 
-// A worker's exception reaches the caller after the others are joined
-// (a joinable std::thread destroyed would abort the process).
-TEST(Workers, AnExceptionInTheCallingThreadIsRethrownAfterJoining) {
+// A worker's exception, from whichever thread, reaches the caller after the
+// others are joined (escaping a thread, or a joinable std::thread destroyed,
+// would abort the process; the asan build found the first).
+TEST(Workers, AnExceptionInAnyThreadIsRethrownAfterJoining) {
   std::atomic<int> calls{0};
   EXPECT_THROW(run_workers(4,
                            [&] {

@@ -10,6 +10,7 @@ namespace ra {
 // a shared queue (e.g. an atomic counter), so that fewer threads than asked
 // still do all of it. Returns how many threads ran (at least 1). A thread the
 // system cannot create is not an error: the ones already running suffice.
+// An exception from any copy is rethrown here after every copy has returned.
 int run_workers(int n, const std::function<void()>& worker);
 
 }  // namespace ra
