@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Command 2 of the README (and what .ci/run runs): install what is missing,
 # build, fetch the mesh corpus into the cache, run the whole test suite
-# through ctest, then a 60-second libFuzzer run per parser. Idempotent.
+# through ctest, then a 30-second libFuzzer run per parser. Idempotent.
 source "$(dirname "$0")/common.sh"
 
 # In CI (CI set) the corpus is fetched into a new, empty cache on every run,
@@ -20,5 +20,5 @@ ci/fetch-corpus.sh "$RAYAUDIT"
 step "running the test suite (ctest --preset release)"
 ctest --preset release -j "$JOBS"
 
-step "fuzzing the OBJ and MTL parsers for ${FUZZ_SECONDS:-60} s each (ci/fuzz.sh)"
+step "fuzzing every parser (OBJ, MTL, PLY, OFF, scene JSON, cases CSV, tolerance JSON) for ${FUZZ_SECONDS:-30} s each (ci/fuzz.sh)"
 ci/fuzz.sh

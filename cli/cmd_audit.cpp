@@ -3,6 +3,7 @@
 // answers from any language (--grade), exports cases (--export-cases), merges shards (audit merge).
 #include <unistd.h>
 
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -411,7 +412,14 @@ void setup(CLI::App& app) {
   cmd->add_option("--seed", a->seed, "Seed of every generated case")
       ->capture_default_str()
       ->check(CLI::Validator(
-          [](std::string& v) { return v.find('-') == std::string::npos ? std::string() : "the seed is a non-negative integer"; },
+          [](std::string& v) {
+            // CLI11 would saturate 2^64 and beyond to 2^64-1: out of range is an error.
+            std::uint64_t x = 0;
+            const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+            if (ec == std::errc::result_out_of_range) return std::string("the seed is at most 18446744073709551615 (2^64-1)");
+            if (ec != std::errc() || end != v.data() + v.size()) return std::string("the seed is a non-negative integer");
+            return std::string();
+          },
           "UINT64"));
   cmd->add_option("--threads", a->threads, "Worker threads (0: all cores); results do not depend on it")
       ->capture_default_str()

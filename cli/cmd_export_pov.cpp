@@ -28,6 +28,9 @@ std::string safe_prefix(const std::filesystem::path& out) {
 void run(const Args& a) {
   const std::filesystem::path out(a.out);
   if (out.extension() != ".pov") throw ra::InputError(a.out + ": output must be a .pov file");
+  // One path given twice would keep only the later file (the ini over the scene).
+  if (!a.ini.empty() && std::filesystem::absolute(a.ini).lexically_normal() == std::filesystem::absolute(out).lexically_normal())
+    throw ra::InputError(a.ini + ": --ini names the same file as -o");
   ra::OutputBatch outputs({out, a.ini});
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;

@@ -20,7 +20,9 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Summarise an OBJ file (counts, area, bounding box, materials)");
   cmd->add_option("FILE", o->file, "OBJ file")->required();
   cmd->add_flag("--json", o->json, "Print one JSON object on stdout");
-  cmd->add_option("--threads", o->threads, "Parser threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads", o->threads, "Parser threads (0 = all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
   cmd->callback([o] {
     ra::ObjOptions opt;
     opt.threads = o->threads;

@@ -1,6 +1,8 @@
 // `rayaudit render SCENE -o OUT`: renders a scene file (or a bare .obj).
+#include <cstdint>
 #include <iostream>
 
+#include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "registry.h"
@@ -23,6 +25,19 @@ int samples_per_axis(int spp) {
     if (n * n == spp) return n;
   throw ra::InputError("--spp must be a square number of samples per pixel (1, 4, 9, ... 256), got " +
                        std::to_string(spp));
+}
+
+// Absurd work is refused before it starts: at most kMaxPrimaryRays primary
+// rays (16384x16384 at 16 spp); 16384x16384 at 256 spp would take hours.
+constexpr std::uint64_t kMaxPrimaryRays = std::uint64_t(1) << 32;
+
+void check_work(const ra::Scene& scene, int spp) {
+  const std::uint64_t rays = std::uint64_t(scene.width) * std::uint64_t(scene.height) * std::uint64_t(spp);
+  if (rays > kMaxPrimaryRays)
+    throw ra::InputError(std::to_string(scene.width) + "x" + std::to_string(scene.height) + " at " +
+                         std::to_string(spp) + " spp is " + std::to_string(rays) +
+                         " primary rays, more than the limit of " + std::to_string(kMaxPrimaryRays) +
+                         " (16384x16384 at 16 spp): lower --width, --height or --spp");
 }
 
 void run(const Args& a) {
@@ -65,11 +80,14 @@ void run(const Args& a) {
     std::string ext = std::filesystem::path(a.out).extension().string();
     if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR")
       throw ra::InputError(a.out + ": output must be .png or .exr");
+    // Its directory too: a missing one used to be found after the render.
+    ra::check_output_path(a.out);
   }
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
   if (a.height > 0) scene.height = a.height;
   if (a.width > 0 || a.height > 0) ra::apply_content_defaults(scene);
+  check_work(scene, a.spp);
   const ra::Image img = ra::render(scene, opt);
   ra::write_image(a.out, img, {a.bits, a.srgb});
 }

@@ -2,6 +2,7 @@
 // Exit codes: 0 ok, 1 a check failed, 2 bad input or usage.
 #include <algorithm>
 #include <iostream>
+#include <string_view>
 
 #include "command.h"
 #include "errors.h"
@@ -14,6 +15,11 @@ std::vector<Command>& commands() {
 }  // namespace ra::cli
 
 int main(int argc, char** argv) {
+  // Answered before any command is set up, with its newline.
+  if (argc == 2 && std::string_view(argv[1]) == "--version") {
+    std::cout << "rayaudit " << RAYAUDIT_VERSION << "\n";
+    return 0;
+  }
   CLI::App app{"rayaudit: is your ray-intersection code right, and how fast is it?", "rayaudit"};
   app.set_version_flag("--version", std::string("rayaudit ") + RAYAUDIT_VERSION);
   app.require_subcommand(1);

@@ -1,5 +1,10 @@
 #include "atomic_file.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <random>
 #include <system_error>
@@ -20,7 +25,11 @@ void write_atomically(const std::filesystem::path& path,
   std::error_code ec;
   check_output_path(path);
   std::random_device rd;
-  const fs::path tmp = dir / (".tmp-" + std::to_string(rd()) + "-" + path.filename().string());
+  // A name near NAME_MAX (255) would not fit with the prefix: keep only the
+  // extension then (the image writers need it).
+  std::string tmp_name = ".tmp-" + std::to_string(rd()) + "-" + path.filename().string();
+  if (tmp_name.size() > 200) tmp_name = ".tmp-" + std::to_string(rd()) + path.extension().string().substr(0, 16);
+  const fs::path tmp = dir / tmp_name;
   try {
     write(tmp);
   } catch (...) {
@@ -93,12 +102,28 @@ OutputBatch::~OutputBatch() {
   g_batch = outer_;
 }
 
+void write_bytes_checked(const std::filesystem::path& file, const void* data, std::size_t size,
+                         const std::string& shown) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw InputError(located(shown, 0, std::string("cannot write: ") + std::strerror(errno)));
+  const char* p = static_cast<const char*>(data);
+  std::size_t left = size;
+  int err = 0;
+  while (left > 0 && !err) {
+    const ssize_t w = ::write(fd, p, left);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) err = w < 0 ? errno : ENOSPC;  // write() of 0 bytes: no room
+    else p += w, left -= std::size_t(w);
+  }
+  // Some file systems report a full disk only when the data is flushed.
+  if (!err && ::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) err = errno;
+  if (::close(fd) != 0 && !err) err = errno;
+  if (err) throw InputError(located(shown, 0, std::string("cannot write: ") + std::strerror(err)));
+}
+
 void write_text_atomically(const std::filesystem::path& path, const std::string& text) {
   write_atomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    f.close();
-    if (!f) throw InputError(located(path.string(), 0, "cannot write"));
+    write_bytes_checked(tmp, text.data(), text.size(), path.string());
   });
 }
 

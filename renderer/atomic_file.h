@@ -2,6 +2,7 @@
 // place, so a failed or interrupted run never leaves a partial output.
 #pragma once
 #include <filesystem>
+#include <cstddef>
 #include <functional>
 #include <string>
 #include <utility>
@@ -17,6 +18,12 @@ void write_atomically(const std::filesystem::path& path,
 
 // Convenience: atomically writes a string.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+// Writes `size` bytes to `file` (created or truncated), checking every
+// write(), fsync() and close(): a full disk is an InputError naming `shown`
+// (the final output name), never a truncated file reported as written.
+void write_bytes_checked(const std::filesystem::path& file, const void* data, std::size_t size,
+                         const std::string& shown);
 
 // Throws InputError `PATH: ...` unless `path` can be an output: its directory
 // exists and it is not itself a directory. Commands call it for every output

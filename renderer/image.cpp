@@ -1,13 +1,20 @@
 #include "image.h"
 
+#include <unistd.h>
+
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <new>
+#include <string>
 
 #include "atomic_file.h"
 #include "errors.h"
+#include "input_file.h"
 
 namespace ra {
 
@@ -21,6 +28,33 @@ float srgb_encode(float x) {
   x = std::clamp(x, 0.0f, 1.0f);
   return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
 }
+// The PNG file's bytes (8 or 16 bits per channel).
+std::vector<unsigned char> encode_png(const Image& img, const ImageWriteOptions& opt,
+                                      const std::filesystem::path& path) {
+  const std::size_t n = img.rgb.size();
+  const bool eight = opt.bits == 8;
+  const unsigned max = eight ? 255 : 65535;
+  std::vector<std::uint8_t> px8(eight ? n : 0);
+  std::vector<std::uint16_t> px16(eight ? 0 : n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned q = quantize(opt.srgb ? srgb_encode(img.rgb[i]) : img.rgb[i], max);
+    if (eight) px8[i] = std::uint8_t(q);
+    else px16[i] = std::uint16_t(q);
+  }
+  const OIIO::TypeDesc type = eight ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16;
+  OIIO::ImageSpec spec(img.width, img.height, 3, type);
+  spec.attribute("oiio:ColorSpace", opt.srgb ? "sRGB" : "Linear");
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput proxy(bytes);
+  const std::string name = "memory.png";
+  auto out = OIIO::ImageOutput::create("png");
+  if (!out) throw InputError(located(path.string(), 0, "cannot create: " + OIIO::geterror()));
+  if (!out->set_ioproxy(&proxy) || !out->open(name, spec) ||
+      !out->write_image(type, eight ? static_cast<const void*>(px8.data()) : px16.data()) || !out->close())
+    throw InputError(located(path.string(), 0, "cannot encode PNG: " + out->geterror()));
+  return bytes;
+}
+
 }  // namespace
 
 void write_image(const std::filesystem::path& path, const Image& img, const ImageWriteOptions& opt) {
@@ -31,48 +65,108 @@ void write_image(const std::filesystem::path& path, const Image& img, const Imag
   if (ext == ".png" && opt.bits != 8 && opt.bits != 16)
     throw InputError(located(path.string(), 0, "PNG bits must be 8 or 16"));
   write_atomically(path, [&](const std::filesystem::path& tmp) {
-    auto out = OIIO::ImageOutput::create(tmp.string());
-    if (!out) throw InputError(located(path.string(), 0, "cannot create: " + OIIO::geterror()));
-    const std::size_t n = img.rgb.size();
     if (ext == ".exr") {
+      auto out = OIIO::ImageOutput::create(tmp.string());
+      if (!out) throw InputError(located(path.string(), 0, "cannot create: " + OIIO::geterror()));
       OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
       if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, img.rgb.data()))
         throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
-    } else if (opt.bits == 8) {
-      std::vector<std::uint8_t> px(n);
-      for (std::size_t i = 0; i < n; ++i)
-        px[i] = std::uint8_t(quantize(opt.srgb ? srgb_encode(img.rgb[i]) : img.rgb[i], 255));
-      OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
-      spec.attribute("oiio:ColorSpace", opt.srgb ? "sRGB" : "Linear");
-      if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()))
-        throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
-    } else {
-      std::vector<std::uint16_t> px(n);
-      for (std::size_t i = 0; i < n; ++i)
-        px[i] = std::uint16_t(quantize(opt.srgb ? srgb_encode(img.rgb[i]) : img.rgb[i], 65535));
-      OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT16);
-      spec.attribute("oiio:ColorSpace", opt.srgb ? "sRGB" : "Linear");
-      if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT16, px.data()))
-        throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
+      // close() flushes: a failure here (disk full) must not rename a
+      // truncated file into place.
+      if (!out->close()) throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
+      return;
     }
-    // close() flushes: a failure here (disk full) must not rename a
-    // truncated file into place.
-    if (!out->close()) throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
+    // OIIO's PNG writer does not report a failed write (full disk: exit 0
+    // and a truncated file), so the PNG is encoded in memory and written
+    // with every write, fsync and close checked.
+    const std::vector<unsigned char> png = encode_png(img, opt, path);
+    write_bytes_checked(tmp, png.data(), png.size(), path.string());
   });
 }
 
-Image read_image(const std::filesystem::path& path) {
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) throw InputError(located(path.string(), 0, "cannot read image: " + OIIO::geterror()));
+namespace {
+
+// libpng and some OIIO readers print their complaints on stderr themselves
+// (4-5 lines for a truncated PNG, the first naming no file). While an image
+// is read, fd 2 goes to a scratch file; the error thrown names the file.
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    std::FILE* sink = std::tmpfile();
+    if (saved_ >= 0 && sink) ::dup2(::fileno(sink), 2);
+    if (sink) std::fclose(sink);  // fd 2 keeps the (already unlinked) file open
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ >= 0) {
+      ::dup2(saved_, 2);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
+// The first line of an OIIO error text (they can run to several).
+std::string first_line(std::string s) {
+  const auto nl = s.find('\n');
+  if (nl != std::string::npos) s.resize(nl);
+  return s.empty() ? "unreadable or unsupported image" : s;
+}
+
+}  // namespace
+
+std::vector<float> read_pixels(const std::filesystem::path& path, const char* what, int& width, int& height,
+                               int& channels) {
+  check_input_file(path);  // a FIFO would block OIIO forever; a directory is "not a PNG file"
+  std::error_code ec;
+  const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+  const std::string name = path.string();
+  QuietStderr quiet;
+  auto in = OIIO::ImageInput::open(name);
+  if (!in) throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + first_line(OIIO::geterror())));
   const OIIO::ImageSpec& spec = in->spec();
-  std::vector<float> all(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw InputError(located(path.string(), 0, "cannot read image: " + in->geterror()));
-  Image img(spec.width, spec.height);
-  for (std::size_t i = 0, n = std::size_t(spec.width) * spec.height; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-      img.rgb[i * 3 + c] = all[i * spec.nchannels + std::min(c, spec.nchannels - 1)];
+  const std::uint64_t w = std::uint64_t(std::max(spec.width, 0)), h = std::uint64_t(std::max(spec.height, 0));
+  const std::string dims = std::to_string(w) + "x" + std::to_string(h);
+  if (w == 0 || h == 0 || spec.nchannels < 1 || spec.nchannels > 64)
+    throw InputError(located(name, 0, what + std::string(" header declares ") + dims + " with " +
+                                          std::to_string(spec.nchannels) + " channels"));
+  // The header's size is trusted only as far as the file can hold it: at
+  // most kMaxPixelsPerByte pixels a byte, and never beyond the render limit.
+  if (w > kMaxImageSide || h > kMaxImageSide)
+    throw InputError(located(name, 0, what + std::string(" is ") + dims + ", more than the limit of " +
+                                          std::to_string(kMaxImageSide) + " pixels a side"));
+  if (!ec && w * h > bytes * kMaxPixelsPerByte)
+    throw InputError(located(name, 0, what + std::string(" header declares ") + dims + " pixels, more than its " +
+                                          std::to_string(bytes) + " bytes can hold (the file is truncated or corrupt)"));
+  width = int(w);
+  height = int(h);
+  channels = spec.nchannels;
+  std::vector<float> all;
+  try {
+    all.resize(std::size_t(w * h) * std::size_t(channels));
+  } catch (const std::bad_alloc&) {  // a legal size this machine cannot hold: still about this file
+    throw InputError(located(name, 0, what + std::string(" of ") + dims + " needs " +
+                                          std::to_string(w * h * std::uint64_t(channels) * 4 >> 20) +
+                                          " MB to read: not enough memory"));
+  }
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data()))
+    throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + first_line(in->geterror())));
   in->close();
+  return all;
+}
+
+Image read_image(const std::filesystem::path& path) {
+  int w = 0, h = 0, nc = 0;
+  const std::vector<float> all = read_pixels(path, "image", w, h, nc);
+  Image img(w, h);
+  for (std::size_t i = 0, n = std::size_t(w) * h; i < n; ++i)
+    for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = all[i * nc + std::min(c, nc - 1)];
   return img;
 }
 

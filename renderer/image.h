@@ -1,6 +1,7 @@
 // Linear float RGB images and their files, through OpenImageIO: PNG 8 or 16
 // bits per channel (linear values unless sRGB is asked for), EXR float.
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <vector>
 
@@ -28,6 +29,21 @@ unsigned quantize(float x, unsigned max);
 // Writes atomically (temporary file renamed into place). The format comes
 // from the extension: .png or .exr. Throws InputError on failure.
 void write_image(const std::filesystem::path& path, const Image& img, const ImageWriteOptions& opt = {});
+
+// Limits on an image read from a file (textures, goldens, POV-Ray's output):
+// a side at most the render's limit (--width, --height), and at most
+// kMaxPixelsPerByte pixels for each byte of the file (deflate's maximum ratio,
+// 1032:1, at 1 bit a pixel: 8256), so a 69-byte PNG declaring 20000x20000 is
+// refused from its header, not after 4.8 GB.
+constexpr std::uint64_t kMaxImageSide = 16384;
+constexpr std::uint64_t kMaxPixelsPerByte = 8 * 1032;
+
+// The pixels of an image file as floats, `channels` per pixel, checking the
+// limits above and the path (a directory or FIFO is named as such). `what`
+// names the file's role in messages ("image", "texture"). libpng's own
+// stderr text is suppressed: every failure is one InputError naming the file.
+std::vector<float> read_pixels(const std::filesystem::path& path, const char* what, int& width, int& height,
+                               int& channels);
 
 // Reads any image OpenImageIO can read, as linear float RGB (no colour
 // conversion: a PNG's 8-bit values v become v / 255).

@@ -33,6 +33,7 @@
 // Any error in parallel mode re-runs the serial parse, so the message is the
 // one of the first error in the file, as in serial mode.
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <exception>
@@ -53,8 +54,10 @@
 #endif
 
 #include "mesh.h"
+#include "input_file.h"
 #include "obj_text.h"
 #include "triangulate.h"
+#include "workers.h"
 
 namespace ra {
 namespace {
@@ -903,21 +906,18 @@ void run_parallel(std::vector<Chunk>& chunks, F&& f) {
     f(chunks[0]);
     return;
   }
-  std::vector<std::thread> threads;
-  for (size_t i = 1; i < chunks.size(); ++i)
-    threads.emplace_back([&, i] {
+  // Chunks are taken from a counter, so fewer threads than chunks (the
+  // system refusing some) still parse every chunk.
+  std::atomic<size_t> next{0};
+  run_workers(int(chunks.size()), [&] {
+    for (size_t i; (i = next.fetch_add(1)) < chunks.size();) {
       try {
         f(chunks[i]);
       } catch (...) {
         chunks[i].error = std::current_exception();
       }
-    });
-  try {
-    f(chunks[0]);
-  } catch (...) {
-    chunks[0].error = std::current_exception();
-  }
-  for (auto& t : threads) t.join();
+    }
+  });
 }
 
 bool any_error(const std::vector<Chunk>& chunks) {
@@ -962,9 +962,11 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
         const std::string key = file.lexically_normal().string();
         if (std::find(loaded.begin(), loaded.end(), key) != loaded.end()) continue;
         loaded.push_back(key);
-        if (!fs::is_regular_file(file, ec)) {
-          m.warnings.push_back(
-              located(m.path, line, "material library '" + f + "' not found (its materials get defaults)"));
+        if (const std::string why = input_file_problem(file); !why.empty()) {
+          m.warnings.push_back(located(m.path, line,
+                                       "material library '" + f + "' " +
+                                           (why == "no such file" ? std::string("not found") : why) +
+                                           " (its materials get defaults)"));
           continue;
         }
         for (auto& mat : load_mtl(file, m.warnings)) {
@@ -1178,6 +1180,7 @@ Mesh parse_obj(std::string_view text, const std::string& name, const ObjOptions&
 }
 
 std::string read_file_bytes(const std::filesystem::path& file, std::uint64_t max_bytes) {
+  check_input_file(file);  // a directory, FIFO or device named as such
   std::error_code ec;
   const auto size = std::filesystem::file_size(file, ec);
   if (ec) throw InputError(located(file.string(), 0, "cannot read: " + ec.message()));

@@ -1,6 +1,9 @@
 #include "polymesh_io.h"
 
 #include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 
 #include "atomic_file.h"
@@ -137,6 +140,34 @@ struct BinReader {
   }
 };
 
+// A value as a message shows it (nan, inf, 3.5, 7).
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// The fewest bytes one row of `el` takes: each value's size in binary, and
+// in ASCII one character and one separator a value.
+std::size_t min_row_bytes(const PlyElement& el, int format) {
+  std::size_t n = 0;
+  for (const auto& pr : el.props) n += format == 0 ? 2 : std::size_t(ply_size(pr.list ? pr.count_type : pr.type));
+  return std::max<std::size_t>(n, 1);  // a row without properties is still a line (or a byte)
+}
+
+// Every row takes at least a byte: more rows than bytes is refused at the
+// header. Fewer, but still more than the data holds, fail where the data
+// ends (with its line, or its byte offset in binary).
+void check_ply_counts(const std::vector<PlyElement>& elements, std::size_t data_bytes, Tokens& t) {
+  std::uint64_t rows = 0;
+  for (const auto& el : elements) {
+    rows += std::uint64_t(el.count);
+    if (rows > data_bytes + 1)  // the last ASCII line may lack its newline
+      t.fail("element '" + el.name + "' declares " + std::to_string(el.count) + " rows, more than the " +
+             std::to_string(data_bytes) + " bytes after the header can hold");
+  }
+}
+
 }  // namespace
 
 PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
@@ -182,6 +213,9 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
     }
   }
   if (format < 0) t.fail("no format line");
+  // Counts are trusted only as far as the bytes after the header can hold
+  // them (a count of 2^31 would otherwise reserve gigabytes first).
+  check_ply_counts(elements, std::size_t(t.e - t.p), t);
   PolyMesh m;
   m.face_start.push_back(0);
   BinReader br{reinterpret_cast<const unsigned char*>(t.p), reinterpret_cast<const unsigned char*>(bytes.data()),
@@ -199,21 +233,32 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
     }
     if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) t.fail("vertex element without x, y, z");
     if (is_face && ilist < 0) t.fail("face element without vertex_indices");
-    if (is_vertex) m.positions.reserve(size_t(el.count));
+    // Reserve no more than the data can hold (a count alone is not trusted).
+    if (is_vertex) m.positions.reserve(std::min(size_t(el.count), size_t(br.e - br.p) / min_row_bytes(el, format) + 1));
     for (long r = 0; r < el.count; ++r) {
       Vec3d pos;
       for (size_t i = 0; i < el.props.size(); ++i) {
         const auto& pr = el.props[i];
         auto value = [&](PlyType ty) { return format == 0 ? t.number<double>("PLY value") : br.get(ty); };
+        // Binary data has no lines: its errors name the byte offset.
+        auto fail = [&](const std::string& what) {
+          if (format == 0) t.fail(what);
+          throw InputError(located(name, 0, "byte " + std::to_string(br.p - br.b) + ": " + what));
+        };
         if (pr.list) {
           const double c = value(pr.count_type);
-          if (c < 0 || c > 1e6 || c != double(long(c))) t.fail("bad list count");
+          if (!(c >= 0 && c <= 1e6) || c != double(long(c))) fail("bad list count " + number_text(c));
           for (long j = 0; j < long(c); ++j) {
             const double v = value(pr.type);
-            if (int(i) == ilist) m.indices.push_back(int(v));
+            if (int(i) == ilist) {
+              // NaN or a fraction is not an index (int(NaN) would read as -2147483648).
+              if (!(v >= -2147483648.0 && v <= 2147483647.0) || v != std::floor(v))
+                fail("face " + std::to_string(r) + " has vertex index " + number_text(v) + ", not an integer");
+              m.indices.push_back(int(v));
+            }
           }
           if (int(i) == ilist) {
-            if (c < 3) t.fail("face with fewer than 3 vertices");
+            if (c < 3) fail("face with fewer than 3 vertices");
             if (vertices_read)
               for (size_t k = m.indices.size() - size_t(c); k < m.indices.size(); ++k)
                 if (m.indices[k] < 0 || m.indices[k] >= long(m.positions.size())) {
@@ -227,6 +272,8 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
           }
         } else {
           const double v = value(pr.type);
+          if ((int(i) == ix || int(i) == iy || int(i) == iz) && !std::isfinite(v))
+            fail("vertex " + std::to_string(r) + " has coordinate " + number_text(v) + " (not finite)");
           if (int(i) == ix) pos.x = v;
           if (int(i) == iy) pos.y = v;
           if (int(i) == iz) pos.z = v;
@@ -242,22 +289,41 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
   return m;
 }
 
+// The OFF family's headers: [ST][C][N]OFF (texture coordinates, colours,
+// normals). 4OFF and nOFF (other dimensions) are not 3-D meshes.
+static bool off_magic(std::string_view m) {
+  if (m.size() < 3 || m.substr(m.size() - 3) != "OFF") return false;
+  m.remove_suffix(3);
+  if (m.rfind("ST", 0) == 0) m.remove_prefix(2);
+  if (!m.empty() && m[0] == 'C') m.remove_prefix(1);
+  if (!m.empty() && m[0] == 'N') m.remove_prefix(1);
+  return m.empty();
+}
+
 PolyMesh parse_off(std::string_view text, const std::string& name) {
   Tokens t{text.data(), text.data() + text.size(), name};
   const std::string_view magic = t.word();
-  if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF") t.fail("not an OFF file (no OFF header)");
+  if (!off_magic(magic)) t.fail("not an OFF file (header '" + std::string(magic.substr(0, 20)) + "', expected OFF, COFF, NOFF, CNOFF, STOFF ...)");
   const long nv = t.number<long>("vertex count"), nf = t.number<long>("face count");
   t.number<long>("edge count");
   if (nv < 0 || nf < 0 || nv > (1L << 31) || nf > (1L << 31)) t.fail("counts out of range");
+  // Each vertex or face takes more than a byte: counts beyond the bytes that
+  // follow are refused at once, and no more is reserved than those hold
+  // ("0 0 0": 5 bytes a vertex). Truncated data fails at its line.
+  const auto left = std::uint64_t(t.e - t.p);
+  if (std::uint64_t(nv) + std::uint64_t(nf) > left)
+    t.fail(std::to_string(nv) + " vertices and " + std::to_string(nf) + " faces cannot fit in the " +
+           std::to_string(left) + " bytes that follow");
   t.next_line();
   PolyMesh m;
-  m.positions.reserve(size_t(nv));
+  m.positions.reserve(std::min(size_t(nv), size_t(left / 5) + 1));
   for (long i = 0; i < nv; ++i) {
     t.skip(true);
     Vec3d p;
     p.x = t.number_on_line<double>("x coordinate");
     p.y = t.number_on_line<double>("y coordinate");
     p.z = t.number_on_line<double>("z coordinate");
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) t.fail("coordinate not finite");
     m.positions.push_back(p);
     t.next_line();
   }

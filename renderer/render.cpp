@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <system_error>
 #include <thread>
 #include <type_traits>
 
@@ -21,6 +22,7 @@
 #include "pov_mesh.h"
 #include "registry.h"
 #include "texture.h"
+#include "workers.h"
 
 namespace ra {
 
@@ -766,26 +768,28 @@ Image Tracer::render() const {
   };
   const bool show = impl_->opt.progress && isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
-  if (show) {
-    // The main thread reports progress while the others work, once the
-    // render has taken more than a moment.
-    pool.emplace_back(worker);
-    bool printed = false;
-    while (done.load() < tiles) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (secs > 0.5) {
-        std::fprintf(stderr, "\rrendering %dx%d: %3d%% (%.1f s)", s.width, s.height, 100 * done.load() / tiles, secs);
-        printed = true;
+  // A reporter thread shows progress once the render has taken more than a
+  // moment; without one (the system refusing the thread) the render goes on.
+  std::atomic<bool> finished{false};
+  std::thread reporter;
+  if (show) try {
+    reporter = std::thread([&] {
+      bool printed = false;
+      while (!finished.load() && done.load() < tiles) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (secs > 0.5 && !finished.load()) {
+          std::fprintf(stderr, "\rrendering %dx%d: %3d%% (%.1f s)", s.width, s.height, 100 * done.load() / tiles, secs);
+          printed = true;
+        }
       }
-    }
-    if (printed) std::fprintf(stderr, "\r\033[K");
-  } else {
-    worker();
+      if (printed) std::fprintf(stderr, "\r\033[K");
+    });
+  } catch (const std::system_error&) {
   }
-  for (auto& th : pool) th.join();
+  run_workers(threads, worker);
+  finished = true;
+  if (reporter.joinable()) reporter.join();
   return img;
 }
 

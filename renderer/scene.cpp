@@ -12,12 +12,22 @@
 #include <sstream>
 
 #include "errors.h"
+#include "input_file.h"
+#include "json_input.h"
 #include "scene_mesh.h"
 
 namespace ra {
 namespace {
 
 using json = nlohmann::json;
+
+// "file not found: PATH" as before, or what the path is instead of a file
+// (a directory, a FIFO that would block, a device); empty when it is one.
+std::string file_problem(const std::filesystem::path& p) {
+  const std::string why = input_file_problem(p);
+  if (why.empty()) return why;
+  return why == "no such file" ? "file not found: " + p.string() : p.string() + ": " + why;
+}
 
 // Reads one JSON object, remembering its path for error messages and which
 // keys were used, so that a misspelt key is an error rather than ignored.
@@ -149,7 +159,7 @@ Material parse_material(const json& j, const std::string& path, const std::files
       tex.filter = parse_filter(tr, "filter");
       tr.finish();
     }
-    if (!std::filesystem::exists(tex.file)) r.fail(r.at("texture"), "file not found: " + tex.file.string());
+    if (const auto why = file_problem(tex.file); !why.empty()) r.fail(r.at("texture"), why);
     m.texture = tex;
   }
   if (r.has("bump")) {
@@ -157,7 +167,7 @@ Material parse_material(const json& j, const std::string& path, const std::files
     BumpMap b;
     if (!br.has("file")) br.fail(br.path(), "missing key \"file\"");
     b.file = resolve(file, br.string("file", ""));
-    if (!std::filesystem::exists(b.file)) br.fail(br.at("file"), "file not found: " + b.file.string());
+    if (const auto why = file_problem(b.file); !why.empty()) br.fail(br.at("file"), why);
     const std::string v = br.string("variant", "height");
     if (v == "height") b.variant = BumpVariant::height;
     else if (v == "normal-map") b.variant = BumpVariant::normal_map;
@@ -231,8 +241,7 @@ Object parse_object(const json& j, const std::string& path, const std::filesyste
     if (r.has("material")) {
       place.material_override = parse_material(r.get("material"), r.at("material"), file);
     }
-    if (!std::filesystem::exists(place.file))
-      r.fail(r.at("mesh"), "file not found: " + place.file.string());
+    if (const auto why = file_problem(place.file); !why.empty()) r.fail(r.at("mesh"), why);
     r.finish();
     o.mesh = load_placed_mesh(place);
     return o;
@@ -243,37 +252,12 @@ Object parse_object(const json& j, const std::string& path, const std::filesyste
   return o;
 }
 
-// 1-based line of a byte offset, for parse errors.
-long line_of(const std::string& text, std::size_t byte) {
-  long line = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i)
-    if (text[i] == '\n') ++line;
-  return line;
-}
-
 }  // namespace
 
 Scene parse_scene_json(const std::string& text, const std::filesystem::path& file) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    // nlohmann's message starts "[json.exception.parse_error.101] parse error at line L, column C: ..."
-    std::string msg = e.what();
-    const auto colon = msg.find("syntax error");
-    if (colon != std::string::npos) msg = msg.substr(colon);
-    throw InputError(located(file.string(), line_of(text, e.byte == 0 ? 0 : e.byte - 1), "invalid JSON: " + msg));
-  } catch (const json::out_of_range& e) {
-    // "[json.exception.out_of_range.406] number overflow parsing '1e999'":
-    // no position is given, so the line is that of the number's first
-    // occurrence in the text.
-    const std::string msg = e.what();
-    const auto q = msg.find('\'');
-    const std::string number = q == std::string::npos ? "" : msg.substr(q + 1, msg.rfind('\'') - q - 1);
-    const auto at = number.empty() ? std::string::npos : text.find(number);
-    throw InputError(located(file.string(), at == std::string::npos ? 0 : line_of(text, at),
-                             "number " + (number.empty() ? std::string("out of range") : number + " overflows a double")));
-  }
+  // Line-located errors, overflowing numbers at their place, duplicate keys refused.
+  const json j = parse_json_text(text, file.string());
+  if (!j.is_object()) throw InputError(located(file.string(), 0, "expected a JSON object {\"width\": ..., \"objects\": [...]}"));
   Scene s;
   s.file = file;
   ObjectReader r(j, "", file.string());
@@ -322,9 +306,7 @@ Scene parse_scene_json(const std::string& text, const std::filesystem::path& fil
 }
 
 Scene load_scene(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw InputError(located(file.string(), 0, "no such file"));
+  check_input_file(file);  // "is a directory", not "no such file"
   std::string ext = file.extension().string();
   for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
   if (ext == ".obj") {

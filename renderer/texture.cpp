@@ -1,10 +1,11 @@
 #include "texture.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <cmath>
+#include <new>
+#include <optional>
 
 #include "errors.h"
+#include "image.h"
 
 namespace ra {
 namespace {
@@ -65,18 +66,19 @@ Vec3d Texture::bilinear(double u, double v) const {
 }
 
 Texture load_texture(const std::filesystem::path& file) {
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw InputError(located(file.string(), 0, "cannot read texture: " + OIIO::geterror()));
-  const OIIO::ImageSpec& spec = in->spec();
-  const int nc = spec.nchannels;
-  std::vector<float> all(std::size_t(spec.width) * spec.height * nc);
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data()))
-    throw InputError(located(file.string(), 0, "cannot read texture: " + in->geterror()));
-  in->close();
-  Texture t(spec.width, spec.height);
-  for (std::size_t i = 0, n = std::size_t(spec.width) * spec.height; i < n; ++i)
+  int w = 0, h = 0, nc = 0;
+  const std::vector<float> all = read_pixels(file, "texture", w, h, nc);
+  std::optional<Texture> made;
+  try {
+    made.emplace(w, h);
+  } catch (const std::bad_alloc&) {
+    throw InputError(located(file.string(), 0, "texture of " + std::to_string(w) + "x" + std::to_string(h) +
+                                                   " pixels: not enough memory"));
+  }
+  Texture& t = *made;
+  for (std::size_t i = 0, n = std::size_t(w) * h; i < n; ++i)
     for (int c = 0; c < 3; ++c) t.rgb[i * 3 + c] = all[i * nc + (nc >= 3 ? c : 0)];
-  return t;
+  return std::move(t);
 }
 
 const Texture& TextureCache::load(const std::filesystem::path& file) {

@@ -1,6 +1,8 @@
 #include "triangulate.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace ra {
 namespace {
@@ -46,34 +48,90 @@ void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
     Vec3d d = pts[i] - o;
     s.q[size_t(i)] = {d[u], sign * d[v]};
   }
-  s.remaining.resize(size_t(n));
-  for (int i = 0; i < n; ++i) s.remaining[size_t(i)] = i;
-  auto& r = s.remaining;
-  const auto& q = s.q;
-  while (r.size() > 3) {
-    const size_t m = r.size();
-    size_t ear = m;  // none found yet
-    // Try corners 1, 2, ..., m-1, 0 so that a convex polygon gives a fan at 0.
-    for (size_t k = 0; k < m && ear == m; ++k) {
-      const size_t i = (k + 1) % m;
-      const int ip = r[(i + m - 1) % m], ic = r[i], in = r[(i + 1) % m];
-      const P2 &a = q[size_t(ip)], &b = q[size_t(ic)], &c = q[size_t(in)];
-      if (!(orient2(a, b, c) > 0)) continue;  // reflex or flat corner
-      bool empty = true;
-      for (size_t j = 0; j < m && empty; ++j) {
-        const int iv = r[j];
-        if (iv == ip || iv == ic || iv == in) continue;
-        const P2& p = q[size_t(iv)];
-        if (p == a || p == b || p == c) continue;  // duplicated vertex
-        empty = !in_triangle(p, a, b, c);
-      }
-      if (empty) ear = i;
-    }
-    if (ear == m) ear = 1;  // degenerate or not simple: cut corner 1 anyway
-    out.push_back({r[(ear + m - 1) % m], r[ear], r[(ear + 1) % m]});
-    r.erase(r.begin() + long(ear));
+  // The polygon as a doubly linked ring, so cutting a corner is O(1).
+  s.next.resize(size_t(n));
+  s.prev.resize(size_t(n));
+  s.alive.assign(size_t(n), 1);
+  for (int i = 0; i < n; ++i) {
+    s.next[size_t(i)] = (i + 1) % n;
+    s.prev[size_t(i)] = (i + n - 1) % n;
   }
-  out.push_back({r[0], r[1], r[2]});
+  const auto& q = s.q;
+  auto& next = s.next;
+  auto& prev = s.prev;
+  auto convex = [&](int k) {
+    return orient2(q[size_t(prev[size_t(k)])], q[size_t(k)], q[size_t(next[size_t(k)])]) > 0;
+  };
+  // Only a corner that is not convex can lie inside an ear (Meisters), so
+  // only those are tested, found through a uniform grid of about one cell
+  // each: a convex polygon costs O(n), a small ear O(1) tests.
+  s.reflex.clear();
+  double x0 = q[0][0], x1 = x0, y0 = q[0][1], y1 = y0;
+  for (int i = 0; i < n; ++i) {
+    x0 = std::min(x0, q[size_t(i)][0]), x1 = std::max(x1, q[size_t(i)][0]);
+    y0 = std::min(y0, q[size_t(i)][1]), y1 = std::max(y1, q[size_t(i)][1]);
+    if (!convex(i)) s.reflex.push_back(i);
+  }
+  const int g = std::max(1, int(std::sqrt(double(s.reflex.size()))));
+  const double sx = x1 > x0 ? g / (x1 - x0) : 0, sy = y1 > y0 ? g / (y1 - y0) : 0;
+  auto cell = [&](double v, double lo, double scale) {
+    const double c = (v - lo) * scale;
+    return !(c > 0) ? 0 : (c >= g - 1 ? g - 1 : int(c));  // NaN (inf - inf) too: cell 0
+  };
+  s.cell_start.assign(size_t(g) * size_t(g) + 1, 0);
+  for (int w : s.reflex) ++s.cell_start[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx)) + 1];
+  for (size_t k = 1; k < s.cell_start.size(); ++k) s.cell_start[k] += s.cell_start[k - 1];
+  s.cell_items.resize(s.reflex.size());
+  {
+    std::vector<int> fill(s.cell_start.begin(), s.cell_start.end() - 1);
+    for (int w : s.reflex)
+      s.cell_items[size_t(fill[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx))]++)] = w;
+  }
+  // Work limit (see triangulate.h): beyond it the rest is cut as a fan.
+  long budget = kEarClipWorkPerCorner * long(n);
+  int m = n, cur = 1, since_cut = 0;
+  while (m > 3) {
+    const int a_i = prev[size_t(cur)], c_i = next[size_t(cur)];
+    bool ear = false;
+    if (budget > 0 && convex(cur)) {
+      ear = true;
+      const P2 &a = q[size_t(a_i)], &b = q[size_t(cur)], &c = q[size_t(c_i)];
+      const int cx0 = cell(std::min({a[0], b[0], c[0]}), x0, sx), cx1 = cell(std::max({a[0], b[0], c[0]}), x0, sx);
+      const int cy0 = cell(std::min({a[1], b[1], c[1]}), y0, sy), cy1 = cell(std::max({a[1], b[1], c[1]}), y0, sy);
+      for (int cy = cy0; cy <= cy1 && ear; ++cy)
+        for (int cx = cx0; cx <= cx1 && ear; ++cx) {
+          const size_t k = size_t(cy) * size_t(g) + size_t(cx);
+          --budget;
+          for (int it = s.cell_start[k]; it < s.cell_start[k + 1]; ++it) {
+            const int w = s.cell_items[size_t(it)];
+            --budget;
+            if (!s.alive[size_t(w)] || w == a_i || w == cur || w == c_i) continue;
+            const P2& p = q[size_t(w)];
+            if (p == a || p == b || p == c) continue;  // duplicated vertex
+            if (in_triangle(p, a, b, c)) {
+              ear = false;
+              break;
+            }
+          }
+        }
+    }
+    --budget;
+    if (!ear && budget > 0 && since_cut < m) {  // try the next corner
+      cur = c_i;
+      ++since_cut;
+      continue;
+    }
+    // An ear, or none in a whole turn (degenerate or not simple), or the
+    // work limit spent: cut this corner anyway, so the count still holds.
+    out.push_back({a_i, cur, c_i});
+    s.alive[size_t(cur)] = 0;
+    next[size_t(a_i)] = c_i;
+    prev[size_t(c_i)] = a_i;
+    --m;
+    cur = c_i;
+    since_cut = 0;
+  }
+  out.push_back({prev[size_t(cur)], cur, next[size_t(cur)]});
 }
 
 }  // namespace ra

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "spawn.h"
+#include "workers.h"
 
 namespace ra::audit {
 
@@ -589,10 +590,7 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
     }
   };
   const int n = opt.threads > 0 ? opt.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (int i = 1; i < n; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& th : pool) th.join();
+  ra::run_workers(n, worker);  // fewer threads if the system refuses some
   return rep;
 }
 

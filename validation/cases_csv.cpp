@@ -11,6 +11,7 @@
 
 #include "audit.h"
 #include "errors.h"
+#include "input_file.h"
 
 namespace ra::audit {
 
@@ -50,6 +51,23 @@ std::string hex(double x) {
   return buf;
 }
 
+// The header line as UTF-8 text: a UTF-8 byte-order mark (as spreadsheets
+// write) is dropped; UTF-16 (a BOM or NUL bytes) is refused by name rather
+// than reported as a missing column.
+void check_header_encoding(const std::string& path, long lineno, std::string& line) {
+  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+  if (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0 || line.find('\0') != std::string::npos)
+    throw InputError(located(path, lineno, "the file is UTF-16 (or holds NUL bytes): save it as UTF-8 or ASCII"));
+}
+
+// A column named twice would make one of the two silently ignored.
+void check_unique_columns(const std::string& path, long lineno, const std::vector<std::string>& header) {
+  for (std::size_t i = 0; i < header.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (!header[i].empty() && header[i] == header[j])
+        throw InputError(located(path, lineno, "column '" + header[i] + "' appears twice in the header"));
+}
+
 }  // namespace
 
 std::vector<UserCase> read_cases_csv(const std::string& path) {
@@ -59,6 +77,7 @@ std::vector<UserCase> read_cases_csv(const std::string& path) {
 }
 
 void for_each_case(const std::string& path, const std::function<void(const UserCase&, long line)>& visit) {
+  check_input_file(path);  // a directory is not "empty", a FIFO does not block
   std::ifstream in(path);
   if (!in) throw InputError(located(path, 0, "cannot open the cases file"));
   std::string line;
@@ -67,8 +86,10 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
   while (header.empty() && std::getline(in, line)) {
     ++lineno;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    check_header_encoding(path, lineno, line);
     if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
   }
+  check_unique_columns(path, lineno, header);
   if (header.empty()) throw InputError(located(path, lineno, "empty file: expected a header line"));
   int col[15];
   int id_col = -1;

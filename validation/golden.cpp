@@ -9,6 +9,7 @@
 
 #include "atomic_file.h"
 #include "errors.h"
+#include "json_input.h"
 #include "render.h"
 #include "scene_mesh.h"
 
@@ -180,14 +181,25 @@ std::string combined_hash(const std::map<std::string, std::string>& inputs) {
 GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
   const fs::path m = root_ / "golden" / "manifest.json";
   if (!fs::exists(m)) return;
+  const json j = read_json_file(m.string());  // FILE:LINE errors, duplicate keys refused
   try {
-    const json j = json::parse(read_bytes(m));
-    for (const auto& e : j.at("goldens")) {
-      GoldenEntry g = entry_from(e);
+    if (!j.is_object() || !j.contains("goldens") || !j.at("goldens").is_array())
+      throw InputError(m.string() + ": expected an object with a \"goldens\" array");
+    const json& all = j.at("goldens");
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const std::string at = m.string() + ": /goldens/" + std::to_string(i);
+      if (!all[i].is_object()) throw InputError(at + ": expected an object");
+      GoldenEntry g;
+      try {
+        g = entry_from(all[i]);
+      } catch (const json::exception& e) {
+        throw InputError(at + ": " + json_error_text(e));
+      }
+      if (entries_.count(g.name)) throw InputError(at + ": golden \"" + g.name + "\" listed twice");
       entries_[g.name] = g;
     }
   } catch (const json::exception& e) {
-    throw InputError(m.string() + ": " + e.what());
+    throw InputError(m.string() + ": " + json_error_text(e));
   }
 }
 

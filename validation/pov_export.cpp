@@ -2,6 +2,8 @@
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 
 #include <charconv>
 #include <cmath>
@@ -255,10 +257,17 @@ void copy_pov_image(const std::filesystem::path& source, const std::filesystem::
   const int channels[3] = {0, nch >= 3 ? 1 : 0, nch >= 3 ? 2 : 0};
   OIIO::ImageBuf rgb3 = OIIO::ImageBufAlgo::channels(in, 3, channels);
   const bool eight = in.spec().format == OIIO::TypeDesc::UINT8;
-  rgb3.set_write_format(eight ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+  // Encoded in memory, then written with every write and close checked:
+  // OIIO's PNG writer does not report a full disk (issue 15).
+  OIIO::ImageSpec spec = rgb3.spec();
+  spec.set_format(eight ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+  std::vector<unsigned char> png;
+  OIIO::Filesystem::IOVecOutput proxy(png);
+  auto out = OIIO::ImageOutput::create("png");
+  if (!out || !out->set_ioproxy(&proxy) || !out->open("memory.png", spec) || !rgb3.write(out.get()) || !out->close())
+    throw InputError(located(dest.string(), 0, "cannot encode PNG: " + (out ? out->geterror() : OIIO::geterror())));
   write_atomically(dest, [&](const std::filesystem::path& tmp) {
-    if (!rgb3.write(tmp.string(), OIIO::TypeDesc::UNKNOWN, "png"))
-      throw InputError(located(dest.string(), 0, "cannot write image: " + rgb3.geterror()));
+    write_bytes_checked(tmp, png.data(), png.size(), dest.string());
   });
 }
 

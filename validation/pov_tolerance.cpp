@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "errors.h"
+#include "json_input.h"
 
 namespace ra {
 
@@ -16,14 +17,18 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
   PovTolerance t;
   if (!std::filesystem::exists(file)) return t;
   t.file = file;
-  std::ifstream in(file);
-  nlohmann::json j;
+  const nlohmann::json j = read_json_file(file.string());  // FILE:LINE errors, duplicate keys refused
   try {
-    j = nlohmann::json::parse(in);
+    if (!j.is_object()) throw InputError(file.string() + ": expected a JSON object");
     for (auto it = j.begin(); it != j.end(); ++it)
       if (it.key() != "notes" && it.key() != "width" && it.key() != "height" && it.key() != "pixels" &&
           it.key() != "max_levels_16")
         throw InputError(file.string() + ": /" + it.key() + ": unknown key");
+    for (const char* k : {"width", "height", "max_levels_16"})
+      if (j.contains(k) && !j.at(k).is_number_integer())
+        throw InputError(file.string() + ": /" + k + ": expected an integer");
+    if (j.contains("notes") && !j.at("notes").is_string()) throw InputError(file.string() + ": /notes: expected a string");
+    if (j.contains("pixels") && !j.at("pixels").is_array()) throw InputError(file.string() + ": /pixels: expected an array");
     t.notes = j.value("notes", "");
     if (j.contains("width")) t.width = j.at("width").get<int>();
     if (j.contains("height")) t.height = j.at("height").get<int>();
@@ -34,9 +39,16 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
     for (std::size_t i = 0; i < pixels.size(); ++i) {
       const auto& p = pixels[i];
       const std::string at = file.string() + ": /pixels/" + std::to_string(i);
+      if (!p.is_object()) throw InputError(at + ": expected an object {\"x\", \"y\", \"levels\", \"cause\"}");
+      for (const char* k : {"x", "y", "levels"})
+        if (p.contains(k) && !p.at(k).is_number_integer())
+          throw InputError(at + "/" + k + ": expected an integer");
+      if (p.contains("cause") && !p.at("cause").is_string()) throw InputError(at + "/cause: expected a string");
       for (auto it = p.begin(); it != p.end(); ++it)
         if (it.key() != "x" && it.key() != "y" && it.key() != "levels" && it.key() != "cause")
           throw InputError(at + "/" + it.key() + ": unknown key");
+      for (const char* k : {"x", "y", "cause"})
+        if (!p.contains(k)) throw InputError(at + ": needs \"" + k + "\"");
       if (!p.contains("levels"))
         throw InputError(at + ": needs \"levels\", the largest difference allowed there (8-bit levels)");
       ExplainedPixel e{p.at("x").get<int>(), p.at("y").get<int>(), p.at("levels").get<int>(),
@@ -46,7 +58,7 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
       t.pixels.push_back(e);
     }
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(file.string() + ": " + e.what());
+    throw InputError(file.string() + ": " + json_error_text(e));
   }
   return t;
 }

@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+# Writes the bad-input corpus (issue 15) beside this script: one directory per
+# input kind; cli/badinput_test.cpp runs each file through rayaudit.
+# The files are committed; this script only documents how the binary ones
+# were made (rerun it after changing one). Expected messages: expected.tsv.
+import os, struct, zlib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+def put(kind, name, data):
+    d = os.path.join(HERE, kind)
+    os.makedirs(d, exist_ok=True)
+    if isinstance(data, str):
+        data = data.encode()
+    with open(os.path.join(d, name), 'wb') as f:
+        f.write(data)
+
+def put_dir(kind, name):
+    # A directory where a file is expected (git needs a file inside it).
+    d = os.path.join(HERE, kind, name)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, 'README'), 'w') as f:
+        f.write('A directory given where a file is expected (issue 15).\n')
+
+TRI = 'v 0 0 0\nv 1 0 0\nv 0 1 0\n'
+
+# ---- OBJ ----
+put('obj', 'v_two_values.obj', 'v 1 2\n')
+put('obj', 'v_nan.obj', TRI + 'v nan 0 0\nf 1 2 3\n')
+put('obj', 'v_inf.obj', 'v 0 0 0\nv 1 0 0\nv inf 1 0\nf 1 2 3\n')
+put('obj', 'v_word.obj', 'v 0 zero 0\n')
+put('obj', 'face_index_zero.obj', TRI + 'f 0 1 2\n')
+put('obj', 'face_past_end.obj', TRI + 'f 1 2 9\n')
+put('obj', 'face_two_vertices.obj', TRI + 'f 1 2\n')
+put('obj', 'face_malformed_index.obj', TRI + 'f 1 2 x\n')
+put('obj', 'face_relative_too_far.obj', TRI + 'f -1 -2 -9\n')
+put('obj', 'face_forward_reference.obj', 'f 1 2 3\n' + TRI)
+put('obj', 'face_index_overflow.obj', TRI + 'f 1 2 99999999999999999999\n')
+put('obj', 'vn_two_values.obj', 'vn 1 0\n')
+put('obj', 'vt_no_values.obj', 'vt\n')
+put('obj', 's_bad.obj', TRI + 's maybe\nf 1 2 3\n')
+put('obj', 'utf16.obj', '\ufeffv 0 0 0\n'.encode('utf-16-le'))
+put('obj', 'binary_nul.obj', b'v 0 0 0\n\x00\x01\x02\xff\xfe\n')
+put_dir('obj', 'is_a_directory.obj')
+
+# ---- MTL (each referenced by an OBJ the test writes) ----
+put('mtl', 'kd_two_values.mtl', 'newmtl a\nKd 1 0\n')
+put('mtl', 'kd_words.mtl', 'newmtl a\nKd red green blue\n')
+put('mtl', 'ns_no_value.mtl', 'newmtl a\nNs\n')
+put('mtl', 'd_no_value.mtl', 'newmtl a\nd\n')
+put('mtl', 'illum_huge.mtl', 'newmtl a\nillum 1e300\n')
+put('mtl', 'illum_fraction.mtl', 'newmtl a\nillum 2.5\n')
+put('mtl', 'map_without_file.mtl', 'newmtl a\nmap_Kd -s 1 1 1\n')
+put('mtl', 'map_option_without_value.mtl', 'newmtl a\nmap_Kd -bm\n')
+put('mtl', 'ks_overflow.mtl', 'newmtl a\nKs 1e999 0 0\n')
+
+# ---- PLY ascii ----
+def ply_header(fmt, nv, nf, vtype='float', itype='int', ctype='uchar', extra=''):
+    return ('ply\nformat %s 1.0\nelement vertex %d\nproperty %s x\nproperty %s y\nproperty %s z\n%s'
+            'element face %d\nproperty list %s %s vertex_indices\nend_header\n'
+            % (fmt, nv, vtype, vtype, vtype, extra, nf, ctype, itype))
+ASCII_V = '0 0 0\n1 0 0\n0 1 0\n'
+put('ply', 'no_magic.ply', 'plx\nformat ascii 1.0\nend_header\n')
+put('ply', 'no_end_header.ply', 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n')
+put('ply', 'unknown_format.ply', 'ply\nformat ascii2 1.0\nend_header\n')
+put('ply', 'no_format.ply', 'ply\nelement vertex 0\nend_header\n')
+put('ply', 'count_2pow31.ply', ply_header('ascii', 2147483648, 0) + ASCII_V)
+put('ply', 'count_more_than_file.ply', ply_header('ascii', 1000000000, 1) + ASCII_V + '3 0 1 2\n')
+put('ply', 'unknown_type.ply', 'ply\nformat ascii 1.0\nelement vertex 1\nproperty flot x\nend_header\n0\n')
+put('ply', 'vertex_without_z.ply', 'ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n')
+put('ply', 'property_before_element.ply', 'ply\nformat ascii 1.0\nproperty float x\nend_header\n')
+put('ply', 'index_out_of_range.ply', ply_header('ascii', 3, 1) + ASCII_V + '3 0 1 7\n')
+put('ply', 'nan_coordinate.ply', ply_header('ascii', 3, 1) + '0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'face_two_vertices.ply', ply_header('ascii', 3, 1) + ASCII_V + '2 0 1\n')
+put('ply', 'extra_values.ply', ply_header('ascii', 3, 1) + '0 0 0 9\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'malformed_value.ply', ply_header('ascii', 3, 1) + '0 0 abc\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'list_count_negative.ply', ply_header('ascii', 3, 1) + ASCII_V + '-3 0 1 2\n')
+put('ply', 'unknown_header_line.ply', 'ply\nformat ascii 1.0\nelemnt vertex 1\nend_header\n')
+
+# ---- PLY binary ----
+def bin_v(*pts, fmt='<fff'):
+    return b''.join(struct.pack(fmt, *p) for p in pts)
+V3 = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
+put('ply', 'bin_truncated.ply', ply_header('binary_little_endian', 3, 1).encode() + bin_v(*V3)[:20])
+put('ply', 'bin_index_out_of_range.ply', ply_header('binary_little_endian', 3, 1).encode() + bin_v(*V3)
+    + struct.pack('<Biii', 3, 0, 1, 70000))
+put('ply', 'bin_nan_index.ply', ply_header('binary_little_endian', 3, 1, itype='float').encode() + bin_v(*V3)
+    + struct.pack('<Bfff', 3, 0, 1, float('nan')))
+put('ply', 'bin_fraction_index.ply', ply_header('binary_little_endian', 3, 1, itype='float').encode() + bin_v(*V3)
+    + struct.pack('<Bfff', 3, 0, 1.5, 2))
+put('ply', 'bin_nan_coordinate.ply', ply_header('binary_little_endian', 3, 1).encode()
+    + bin_v((0, 0, 0), (float('nan'), 0, 0), (0, 1, 0)) + struct.pack('<Biii', 3, 0, 1, 2))
+put('ply', 'bin_list_count_huge.ply', ply_header('binary_little_endian', 3, 1, ctype='uint').encode() + bin_v(*V3)
+    + struct.pack('<Iiii', 4000000000, 0, 1, 2))
+put('ply', 'bin_face_two_vertices.ply', ply_header('binary_little_endian', 3, 1).encode() + bin_v(*V3)
+    + struct.pack('<Bii', 2, 0, 1))
+put('ply', 'bin_count_more_than_file.ply', ply_header('binary_little_endian', 100000000, 1).encode() + bin_v(*V3)
+    + struct.pack('<Biii', 3, 0, 1, 2))
+put('ply', 'bin_big_endian_truncated.ply', ply_header('binary_big_endian', 3, 1).encode() + bin_v(*V3, fmt='>fff')
+    + struct.pack('>Bi', 3, 0))
+
+# ---- OFF ----
+put('off', 'zzz_magic.off', 'ZZZOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', '4off_magic.off', '4OFF\n3 1 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2\n')
+put('off', 'no_magic.off', '3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'counts_negative.off', 'OFF\n-3 1 0\n')
+put('off', 'counts_more_than_file.off', 'OFF\n1000000000 1 0\n0 0 0\n')
+put('off', 'counts_2pow31.off', 'OFF\n2147483649 1 0\n0 0 0\n')
+put('off', 'vertex_two_values.off', 'OFF\n3 1 0\n0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'face_index_out_of_range.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n')
+put('off', 'face_two_vertices.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n')
+put('off', 'nan_vertex.off', 'OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'malformed_number.off', 'OFF\n3 1 0\n0 0 0\n1 0 0x\n0 1 0\n3 0 1 2\n')
+
+# ---- scene JSON ----
+put('scene', 'syntax_error.json', '{"width": 8,\n "height": }\n')
+put('scene', 'truncated.json', '{"width": 8,\n "height": 8\n')
+put('scene', 'trailing_garbage.json', '{"width": 8}\nx\n')
+put('scene', 'duplicate_key.json', '{"width": 8,\n "height": 8,\n "width": 9}\n')
+put('scene', 'overflow_number.json', '{"notes": "1e400",\n "width": 1e400}\n')
+put('scene', 'unknown_key.json', '{"width": 8,\n "heigth": 8}\n')
+put('scene', 'width_zero.json', '{"width": 0}\n')
+put('scene', 'width_string.json', '{"width": "eight"}\n')
+put('scene', 'not_an_object.json', '[1, 2]\n')
+put('scene', 'empty.json', '')
+put('scene', 'camera_number.json', '{"camera": 5}\n')
+put('scene', 'mesh_missing.json', '{"objects": [{"mesh": "no-such-mesh.obj"}]}\n')
+put('scene', 'mesh_is_directory.json', '{"objects": [{"mesh": "."}]}\n')
+put('scene', 'utf16.json', '\ufeff{"width": 8}\n'.encode('utf-16-le'))
+put('scene', 'deep_nesting.json', '[' * 100000)
+put('scene', 'sphere_negative_radius.json', '{"objects": [{"sphere": {"center": [0, 0, 0], "radius": -1}}]}\n')
+put_dir('scene', 'is_a_directory.json')
+
+# ---- cases CSV ----
+HEAD = 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n'
+ROW = '0.25,0.25,-1,0,0,1,0,0,0,1,0,0,0,1,0\n'
+put('csv', 'empty.csv', '')
+put('csv', 'missing_column.csv', HEAD.replace('oz,', '') + ROW)
+put('csv', 'utf16.csv', ('\ufeff' + HEAD + ROW).encode('utf-16-le'))
+put('csv', 'duplicate_column.csv', HEAD.strip() + ',ox\n' + ROW.strip() + ',9\n')
+put('csv', 'not_a_number.csv', HEAD + ROW.replace('0.25,0.25', '0.25,abc', 1))
+put('csv', 'field_count.csv', HEAD + '0,0,0\n')
+put('csv', 'overflow.csv', HEAD + ROW.replace('0.25,0.25', '1e400,0.25', 1))
+put('csv', 'binary_nul.csv', b'\x00\x01\x02\n\xff\xfe')
+put('csv', 'second_row_bad.csv', HEAD + ROW + ROW.replace('-1', '-1x'))
+put_dir('csv', 'is_a_directory.csv')
+
+# ---- POV tolerance JSON (compare loads it before rendering) ----
+put('tolerance', 'syntax_error.json', '{"notes": "x",\n "pixels": [}\n')
+put('tolerance', 'duplicate_key.json', '{"notes": "a",\n "notes": "b"}\n')
+put('tolerance', 'not_an_object.json', '[]\n')
+put('tolerance', 'width_string.json', '{"width": "320"}\n')
+put('tolerance', 'pixel_not_object.json', '{"pixels": [5]}\n')
+put('tolerance', 'pixel_x_string.json', '{"pixels": [{"x": "1", "y": 2, "levels": 3, "cause": "c"}]}\n')
+put('tolerance', 'levels_out_of_range.json', '{"pixels": [{"x": 1, "y": 2, "levels": 300, "cause": "c"}]}\n')
+put('tolerance', 'pixel_without_cause.json', '{"pixels": [{"x": 1, "y": 2, "levels": 3}]}\n')
+put('tolerance', 'unknown_key.json', '{"pixel": []}\n')
+put('tolerance', 'max_levels_out_of_range.json', '{"max_levels_16": 99}\n')
+
+# ---- golden manifest (copied to ROOT/golden/manifest.json by the test) ----
+put('golden', 'syntax_error.json', '{"goldens": [\n{]\n')
+put('golden', 'not_an_object.json', '[]\n')
+put('golden', 'goldens_not_array.json', '{"goldens": 5}\n')
+put('golden', 'entry_not_object.json', '{"goldens": [7]}\n')
+put('golden', 'entry_without_name.json', '{"goldens": [{"scene": "s.json"}]}\n')
+put('golden', 'duplicate_key.json', '{"goldens": [],\n "goldens": []}\n')
+put('golden', 'width_string.json', '{"goldens": [{"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", '
+    '"width": "8", "height": 8, "inputs_hash": "x"}]}\n')
+put('golden', 'listed_twice.json', '{"goldens": [' + ','.join(
+    ['{"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": 8, "height": 8, "inputs_hash": "x"}'] * 2)
+    + ']}\n')
+
+# ---- textures (referenced by a scene the test writes) ----
+def png(w, h, data, color=2, depth=8, crc_ok=True):
+    def chunk(t, d):
+        c = zlib.crc32(t + d) & 0xffffffff
+        return struct.pack('>I', len(d)) + t + d + struct.pack('>I', c if crc_ok else c ^ 1)
+    return (b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, depth, color, 0, 0, 0))
+            + chunk(b'IDAT', data) + chunk(b'IEND', b''))
+good = png(2, 2, zlib.compress(b'\x00' + b'\x80' * 6 + b'\x00' + b'\x40' * 6))
+put('texture', 'huge_header.png', png(20000, 20000, zlib.compress(b'\x00' * 8)))
+put('texture', 'header_larger_than_file.png', png(10000, 10000, zlib.compress(b'\x00' * 8)))
+put('texture', 'million_side.png', png(1000000, 1000000, zlib.compress(b'\x00' * 8)))
+put('texture', 'truncated.png', good[:len(good) - 20])
+put('texture', 'bad_crc.png', png(2, 2, zlib.compress(b'\x00' + b'\x80' * 6 + b'\x00' + b'\x40' * 6), crc_ok=False))
+put('texture', 'not_an_image.png', 'this is not a PNG\n')
+put('texture', 'zero_bytes.png', b'')
+put('texture', 'idat_garbage.png', png(4, 4, b'\x01\x02\x03garbage'))
+put('texture', 'not_an_exr.exr', 'v/1\x01 not really an EXR\n')
+put('texture', 'zero_width.png', png(0, 4, zlib.compress(b'\x00' * 4)))
+put_dir('texture', 'is_a_directory.png')

@@ -1,0 +1,234 @@
+// Issue 15 regressions through the real program: full disk, threads the
+// system refuses, work and destinations checked first, inputs that are not
+// files, options that used to be accepted silently.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "full_disk.h"
+#include "run_rayaudit.h"
+
+namespace fs = std::filesystem;
+using ra::test::run_rayaudit;
+
+namespace {
+
+const std::string kScenes = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes";
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("rayaudit-reliab-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d / name;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// AddressSanitizer reserves terabytes of address space: tests that limit it
+// with prlimit --as cannot run under the asan preset.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#define SKIP_IF_SANITIZED() \
+  if (kSanitized) GTEST_SKIP() << "prlimit --as and AddressSanitizer do not mix"
+
+bool one_line(const std::string& s) { return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1; }
+
+TEST(ReliabilityCli, RenderOnAFullDiskExits2AndKeepsTheGoodPng) {
+  ra::test::FullDisk disk;
+  if (!disk.ok()) GTEST_SKIP() << disk.why_not();
+  const fs::path out = disk.dir() / "out.png";
+  std::ofstream(out) << "good";
+  // 400 x 300 of the pyramid scene is an 18 KB PNG; about 8 KB are free.
+  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json -o " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, out.string() + ": cannot write: No space left on device\n");
+  EXPECT_EQ(slurp(out), "good");
+}
+
+TEST(ReliabilityCli, InfoThreadsBeyond1024IsRefused) {
+  const auto r = run_rayaudit("info " + kScenes + "/meshes/quad.obj --threads 100000");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("--threads"), std::string::npos) << r.err;
+}
+
+// Under a 2 GB address-space limit 1024 threads' stacks cannot all be
+// made: the work goes on with the threads that could start, and the result
+// is the one a single thread gives (it used to abort, exit 134).
+TEST(ReliabilityCli, AuditWith1024ThreadsUnderAMemoryLimitFallsBack) {
+  SKIP_IF_SANITIZED();
+  const fs::path many = scratch("audit-1024.json"), one = scratch("audit-1.json");
+  const auto r = run_rayaudit("audit --rays 5000 --threads 1024 --json " + many.string(), "prlimit --as=2000000000 --");
+  ASSERT_EQ(r.code, 0) << r.all;
+  ASSERT_EQ(run_rayaudit("audit --rays 5000 --threads 1 --json " + one.string()).code, 0);
+  EXPECT_EQ(slurp(many), slurp(one));
+}
+
+TEST(ReliabilityCli, RenderWith1024ThreadsUnderAMemoryLimitFallsBack) {
+  SKIP_IF_SANITIZED();
+  const fs::path many = scratch("r-1024.png"), one = scratch("r-1.png");
+  const std::string scene = kScenes + "/doc000-pyramid.json --width 64 --height 48";
+  const auto r = run_rayaudit("render " + scene + " --threads 1024 -o " + many.string(), "prlimit --as=2000000000 --");
+  ASSERT_EQ(r.code, 0) << r.all;
+  ASSERT_EQ(run_rayaudit("render " + scene + " --threads 1 -o " + one.string()).code, 0);
+  EXPECT_EQ(slurp(many), slurp(one));
+}
+
+// Audit JSON is identical for 1, 2 and 7 threads over every method and family.
+TEST(ReliabilityCli, AuditJsonIsIdenticalFor1And2And7Threads) {
+  std::string first;
+  for (int n : {1, 2, 7}) {
+    const fs::path j = scratch("audit-t" + std::to_string(n) + ".json");
+    ASSERT_EQ(run_rayaudit("audit --rays 2000 --threads " + std::to_string(n) + " --json " + j.string()).code, 0);
+    if (first.empty()) first = slurp(j);
+    else EXPECT_EQ(slurp(j), first) << n << " threads";
+  }
+  EXPECT_GT(first.size(), 1000u);
+}
+
+// A missing output directory is found before a 16384 x 16384 render, not after.
+TEST(ReliabilityCli, RenderChecksTheDestinationBeforeTheWork) {
+  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 -o /nonexistent-dir/x.png");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "/nonexistent-dir/x.png: output directory does not exist\n");
+}
+
+TEST(ReliabilityCli, AbsurdRenderIsRefusedWithItsSize) {
+  const fs::path out = scratch("absurd.png");
+  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 --spp 256 -o " +
+                              out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "16384x16384 at 256 spp is 68719476736 primary rays, more than the limit of 4294967296 "
+            "(16384x16384 at 16 spp): lower --width, --height or --spp\n");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(ReliabilityCli, VersionEndsWithANewline) {
+  const auto r = run_rayaudit("--version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out, std::string("rayaudit ") + RAYAUDIT_VERSION + "\n");
+}
+
+TEST(ReliabilityCli, ExportPovWithIniEqualToOutputIsRefused) {
+  const fs::path pov = scratch("same.pov");
+  std::ofstream(pov) << "precious";
+  const auto r = run_rayaudit("export-pov " + kScenes + "/doc000-pyramid.json -o " + pov.string() + " --ini " +
+                              pov.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, pov.string() + ": --ini names the same file as -o\n");
+  EXPECT_EQ(slurp(pov), "precious");
+}
+
+TEST(ReliabilityCli, SeedOf2To64IsRefusedNotSaturated) {
+  const auto r = run_rayaudit("audit --rays 10 --seed 18446744073709551616");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("at most 18446744073709551615"), std::string::npos) << r.err;
+  EXPECT_EQ(run_rayaudit("audit --rays 10 --methods moller --seed 18446744073709551615").code, 0);
+}
+
+// A FIFO as cases CSV or texture is refused at once (it used to block
+// forever); `timeout` turns a hang into exit 124.
+TEST(ReliabilityCli, FifoAsCasesOrTextureIsRefused) {
+  const fs::path fifo = scratch("cases.csv");
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto r = run_rayaudit("audit --cases " + fifo.string(), "timeout 60");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, fifo.string() + ": is a FIFO, not a file\n");
+
+  const fs::path tex = scratch("tex.png"), scene = scratch("tex-scene.json");
+  fs::remove(tex);
+  ASSERT_EQ(::mkfifo(tex.c_str(), 0600), 0);
+  std::ofstream(scene) << R"({"objects": [{"mesh": ")" << kScenes << R"(/meshes/quad.obj", "material": {"texture": ")"
+                       << tex.string() << "\"}}]}\n";
+  r = run_rayaudit("render " + scene.string() + " -o " + scratch("tex.out.png").string(), "timeout 60");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find(tex.string() + ": is a FIFO, not a file"), std::string::npos) << r.err;
+}
+
+TEST(ReliabilityCli, MtllibOfADeviceIsNamedAsSuch) {
+  const fs::path obj = scratch("dev.obj");
+  std::ofstream(obj) << "mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const auto r = run_rayaudit("info " + obj.string());
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.err.find(obj.string() + ":1: material library '/dev/zero' is a device, not a file"), std::string::npos)
+      << r.err;
+}
+
+TEST(ReliabilityCli, SymlinkLoopAsSceneIsOneLine) {
+  const fs::path loop = scratch("loop.json");
+  fs::remove(loop);
+  fs::create_symlink(loop, loop);
+  const auto r = run_rayaudit("render " + loop.string() + " -o " + scratch("loop.png").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, loop.string() + ": cannot read: Too many levels of symbolic links\n");
+}
+
+TEST(ReliabilityCli, OutputNameNear255CharactersIsWritten) {
+  const fs::path out = scratch(std::string(246, 'n') + ".png");
+  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 8 --height 8 -o " + out.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(out));
+}
+
+// convert used to write `v nan 0 0`, which our own OBJ reader rejects.
+TEST(ReliabilityCli, ConvertRefusesANanCoordinate) {
+  const fs::path ply = scratch("nan.ply"), out = scratch("nan.obj");
+  std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                        "nan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const auto r = run_rayaudit("convert " + ply.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, ply.string() + ":10: vertex 0 has coordinate nan (not finite)\n");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+
+namespace {
+
+// A UTF-8 byte-order mark (as spreadsheets write) is not part of the first
+// column's name: it used to read as "missing column 'ox'".
+TEST(ReliabilityCli, CasesCsvWithAUtf8BomIsRead) {
+  const fs::path csv = scratch("bom.csv"), json = scratch("bom.json");
+  std::ofstream(csv) << "\xEF\xBB\xBFox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
+                        "0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n";
+  const auto r = run_rayaudit("audit --cases " + csv.string() + " --methods moller --json " + json.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(json));
+}
+
+}  // namespace
+
+namespace {
+
+// A legal 16384 x 16384 texture (a 32 KB PNG: 1-bit grey, all zero, deflated)
+// that a process limited to 3 GB cannot hold: one line naming the file, not
+// a bare std::bad_alloc.
+TEST(ReliabilityCli, TextureTooLargeForMemoryNamesTheFile) {
+  SKIP_IF_SANITIZED();
+  const std::string tex = std::string(RAYAUDIT_SOURCE_DIR) + "/cli/testdata/texture-16384-1bit.png";
+  const fs::path scene = scratch("bigtex.json");
+  std::ofstream(scene) << R"({"objects": [{"mesh": ")" << kScenes << R"(/meshes/quad.obj", "material": {"texture": ")"
+                       << tex << "\"}}]}\n";
+  const auto r = run_rayaudit("render " + scene.string() + " --width 8 --height 8 -o " + scratch("bigtex.png").string(),
+                              "prlimit --as=3000000000 --");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind(tex + ": ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("not enough memory"), std::string::npos) << r.err;
+}
+
+}  // namespace

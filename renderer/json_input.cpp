@@ -1,0 +1,137 @@
+// A SAX front end to nlohmann's DOM parser (issue 15: raw library messages,
+// the line of an overflowing number, duplicate keys accepted silently).
+#include "json_input.h"
+
+#include <cstddef>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "errors.h"
+#include "input_file.h"
+
+namespace ra {
+namespace {
+
+using json = nlohmann::json;
+
+long line_at(const std::string& text, std::size_t byte) {
+  long line = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) line += text[i] == '\n';
+  return line;
+}
+
+// An iterator over the text that records how far the lexer has read, so a
+// duplicate key can be placed on its line.
+struct CountingIter {
+  using iterator_category = std::input_iterator_tag;
+  using value_type = char;
+  using difference_type = std::ptrdiff_t;
+  using pointer = const char*;
+  using reference = const char&;
+  const char* p;
+  const char* base;
+  std::size_t* read;
+  reference operator*() const { return *p; }
+  CountingIter& operator++() {
+    ++p;
+    *read = std::size_t(p - base);
+    return *this;
+  }
+  CountingIter operator++(int) {
+    CountingIter c = *this;
+    ++*this;
+    return c;
+  }
+  bool operator==(const CountingIter& o) const { return p == o.p; }
+  bool operator!=(const CountingIter& o) const { return p != o.p; }
+};
+
+class Sax {
+ public:
+  Sax(json& root, const std::string& text, const std::string& file, const std::size_t& read)
+      : dom_(root, true), text_(text), file_(file), read_(read) {}
+  bool null() { return dom_.null(); }
+  bool boolean(bool v) { return dom_.boolean(v); }
+  bool number_integer(json::number_integer_t v) { return dom_.number_integer(v); }
+  bool number_unsigned(json::number_unsigned_t v) { return dom_.number_unsigned(v); }
+  bool number_float(json::number_float_t v, const std::string& s) { return dom_.number_float(v, s); }
+  bool string(std::string& v) { return dom_.string(v); }
+  bool binary(json::binary_t& v) { return dom_.binary(v); }
+  bool start_object(std::size_t n) {
+    keys_.emplace_back();
+    return dom_.start_object(n);
+  }
+  bool key(std::string& k) {
+    if (!keys_.back().insert(k).second)
+      throw InputError(located(file_, line_at(text_, read_), "key \"" + k + "\" given twice in one object"));
+    return dom_.key(k);
+  }
+  bool end_object() {
+    keys_.pop_back();
+    return dom_.end_object();
+  }
+  bool start_array(std::size_t n) { return dom_.start_array(n); }
+  bool end_array() { return dom_.end_array(); }
+  bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& e) {
+    const long line = line_at(text_, position == 0 ? 0 : position - 1);
+    if (e.id == 406)  // number overflow: the lexer stands just after the number
+      throw InputError(located(file_, line, "number " + token + " overflows a double"));
+    std::string msg = e.what();
+    const auto at = msg.find("syntax error");
+    if (at != std::string::npos) msg = msg.substr(at);
+    else if (const auto b = msg.find("] "); b != std::string::npos) msg = msg.substr(b + 2);
+    throw InputError(located(file_, line, "invalid JSON: " + msg));
+  }
+
+ private:
+  nlohmann::detail::json_sax_dom_parser<json> dom_;
+  std::vector<std::set<std::string>> keys_;
+  const std::string& text_;
+  const std::string& file_;
+  const std::size_t& read_;
+};
+
+}  // namespace
+
+json parse_json_text(const std::string& text, const std::string& file) {
+  // nlohmann reads UTF-8 only: UTF-16 would be "invalid literal; last read: '\xff'".
+  if (text.rfind("\xFF\xFE", 0) == 0 || text.rfind("\xFE\xFF", 0) == 0 || text.find('\0') != std::string::npos)
+    throw InputError(located(file, line_at(text, text.find('\0') == std::string::npos ? 0 : text.find('\0')),
+                             "the file is UTF-16 (or holds NUL bytes): save it as UTF-8"));
+  json root;
+  std::size_t read = 0;
+  Sax sax(root, text, file, read);
+  const char* b = text.data();
+  CountingIter first{b, b, &read}, last{b + text.size(), b, &read};
+  json::sax_parse(first, last, &sax);
+  return root;
+}
+
+json read_json_file(const std::string& file) {
+  check_input_file(file);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(located(file, 0, "cannot open"));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_json_text(ss.str(), file);
+}
+
+std::string json_error_text(const std::exception& e) {
+  std::string msg = e.what();
+  if (msg.rfind("[json.exception.", 0) == 0)
+    if (const auto b = msg.find("] "); b != std::string::npos) msg = msg.substr(b + 2);
+  // nlohmann's wording, said as the other messages say it.
+  if (msg.rfind("type must be ", 0) == 0) {
+    const auto but = msg.find(", but is ");
+    if (but != std::string::npos)
+      return "expected a " + msg.substr(13, but - 13) + ", got " + msg.substr(but + 9);
+  }
+  if (msg.rfind("key '", 0) == 0 && msg.size() > 15 && msg.compare(msg.size() - 11, 11, "' not found") == 0)
+    return "needs \"" + msg.substr(5, msg.size() - 16) + "\"";
+  return msg;
+}
+
+}  // namespace ra
