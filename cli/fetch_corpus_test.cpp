@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 
 namespace fs = std::filesystem;
 
@@ -52,26 +53,32 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-// True if a name at depth 1 or 2 under `root` ends with `suffix` (every
-// temporary the fetch makes is there; deeper lie thousands of unpacked files).
-bool any_path_ends_with(const fs::path& root, const std::string& suffix) {
+// True if a name at depth 1 or 2 under `root` starts with `prefix` and ends
+// with `suffix` (every temporary the fetch makes is there; deeper lie
+// thousands of unpacked files).
+bool any_path_ends_with(const fs::path& root, const std::string& suffix, const std::string& prefix = "") {
+  auto match = [&](const fs::path& p) {
+    const std::string name = p.filename().string();
+    return name.rfind(prefix, 0) == 0 && ends_with(name, suffix);
+  };
   std::error_code ec;
   for (fs::directory_iterator a(root, ec), end; !ec && a != end; a.increment(ec)) {
-    if (ends_with(a->path().filename().string(), suffix)) return true;
+    if (match(a->path())) return true;
     std::error_code ec2;
     if (!a->is_directory(ec2)) continue;
     for (fs::directory_iterator b(a->path(), ec2); !ec2 && b != end; b.increment(ec2))
-      if (ends_with(b->path().filename().string(), suffix)) return true;
+      if (match(b->path())) return true;
   }
   return false;
 }
 
 // Kills the fetch with SIGKILL as soon as `path_suffix` appears under the
 // cache (a step caught half done). Returns false if the fetch ended first.
-bool kill_when_seen(pid_t pid, const fs::path& cache, const std::string& path_suffix) {
+bool kill_when_seen(pid_t pid, const fs::path& cache, const std::string& path_suffix,
+                    const std::string& path_prefix = "") {
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(5);
   while (std::chrono::steady_clock::now() < give_up) {
-    if (any_path_ends_with(cache / "corpus", path_suffix)) {
+    if (any_path_ends_with(cache / "corpus", path_suffix, path_prefix)) {
       kill(-pid, SIGKILL);
       wait_exit(pid);
       return true;
@@ -114,15 +121,20 @@ TEST(FetchCorpus, KilledPartWayThenRerunEndsWithTheSameCacheAsAnUninterruptedFet
   // Three kills, each in the middle of a different kind of step: a package
   // being unpacked, the dragon being decompressed, a converted mesh being
   // written by rayaudit (its temporary is named .tmp-*).
-  for (const std::string& during : {std::string(".partial"), std::string("dragon.ply.tmp"),
-                                    std::string("_cgal.obj")}) {
+  const std::pair<std::string, std::string> kill_at[] = {
+      {"", ".partial"}, {"", "dragon.ply.tmp"}, {".tmp-", "_cgal.obj"}};
+  for (const auto& [prefix, suffix] : kill_at) {
     const pid_t pid = start_fetch(cache);
-    EXPECT_TRUE(kill_when_seen(pid, cache, during)) << "the fetch ended before '" << during << "' appeared";
+    EXPECT_TRUE(kill_when_seen(pid, cache, suffix, prefix))
+        << "the fetch ended before '" << prefix << "*" << suffix << "' appeared";
   }
   const int rc = wait_exit(start_fetch(cache));
   ASSERT_EQ(rc, 0) << "the rerun after the kills failed (cache kept in " << cache << ")";
   EXPECT_FALSE(any_path_ends_with(cache / "corpus", ".partial")) << "a .partial was left behind";
   EXPECT_FALSE(any_path_ends_with(cache / "corpus", "dragon.ply.tmp")) << "the dragon's PLY was left behind";
+  for (const char* dir : {"ladder", "generated"})
+    for (const auto& e : fs::directory_iterator(cache / "corpus" / dir))
+      EXPECT_NE(e.path().filename().string().rfind(".tmp-", 0), 0u) << "a killed rayaudit's temporary was left: " << e.path();
 
   const auto want = listing(reference), got = listing(cache / "corpus");
   ASSERT_FALSE(want.empty());
