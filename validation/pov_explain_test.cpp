@@ -38,7 +38,9 @@ TEST(PovExplain, CornellBoxEdgePixelIsPovsMeshInsideTest) {
   const auto ex = explain_differences(scene, ours, pov, c, opt);
   for (const auto& e : ex) {
     EXPECT_FALSE(e.cause.empty()) << "(" << e.x << ", " << e.y << ") unexplained";
-    if (e.x == 301 && e.y == 63) EXPECT_EQ(e.cause.rfind("mesh2 intersection", 0), 0u) << e.cause;
+    if (e.x == 301 && e.y == 63) {
+      EXPECT_EQ(e.cause.rfind("mesh2 intersection", 0), 0u) << e.cause;
+    }
   }
 }
 
