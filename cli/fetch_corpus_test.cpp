@@ -139,9 +139,11 @@ TEST(FetchCorpus, KilledPartWayThenRerunEndsWithTheSameCacheAsAnUninterruptedFet
   const auto want = listing(reference), got = listing(cache / "corpus");
   ASSERT_FALSE(want.empty());
   EXPECT_EQ(got, want) << "file list or sizes differ from " << reference;
-  if (got == want)
-    for (const auto& [rel, size] : want)
+  if (got == want) {
+    for (const auto& [rel, size] : want) {
       EXPECT_TRUE(slurp(cache / "corpus" / rel) == slurp(reference / rel)) << rel << " differs";
+    }
+  }
   if (!HasFailure()) fs::remove_all(cache);
 }
 
