@@ -11,4 +11,5 @@ labels="${ASAN_LABELS:-renderer|validation|cli}"
 cmake --preset asan >/dev/null
 cmake --build --preset asan -j "$JOBS"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  LSAN_OPTIONS="suppressions=$PWD/ci/lsan.supp:print_suppressions=0" \
   ctest --preset asan -j "$JOBS" -L "$labels"

@@ -356,6 +356,9 @@ long peak_rss_kb(const std::vector<std::string>& args) {
 // Issue 15: `audit --cases` held every row and its JSON (175x the CSV). Now
 // streamed: 100k rows peak where 20k do (the old code grew ~3 kB per row).
 TEST(AuditCli, CasesMemoryDoesNotGrowWithRows) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's quarantine keeps freed memory: peak RSS says nothing about our rows";
+#endif
   auto make = [&](const fs::path& p, int rows) {
     std::ofstream out(p);
     out << kHeader;

@@ -41,6 +41,14 @@ ShellResult sh(const std::string& cmd) {
 
 std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
+// The asan preset's libraries call the sanitizers' runtime: the consumer is
+// then compiled and linked with the same flags, as a user of such a build would.
+#ifdef RAYAUDIT_CONSUMER_FLAGS
+const std::string kConsumerFlags = " -DCMAKE_CXX_FLAGS='" RAYAUDIT_CONSUMER_FLAGS "' -DCMAKE_EXE_LINKER_FLAGS='" RAYAUDIT_CONSUMER_FLAGS "'";
+#else
+const std::string kConsumerFlags;
+#endif
+
 class PackageConsumer : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -68,7 +76,7 @@ TEST_F(PackageConsumer, InstalledPackageBuildsAUsersProjectAndItsTestReportsTheL
 
   const ShellResult configure = sh(cmake + " -S " + quoted(fs::path(RAYAUDIT_SOURCE_DIR) / "validation/consumer") +
                            " -B " + quoted(build) + " -G Ninja -DCMAKE_BUILD_TYPE=Release" +
-                           " -DCMAKE_PREFIX_PATH=" + quoted(prefix));
+                           " -DCMAKE_PREFIX_PATH=" + quoted(prefix) + kConsumerFlags);
   ASSERT_EQ(configure.code, 0) << configure.out;
   const ShellResult compile = sh(cmake + " --build " + quoted(build));
   ASSERT_EQ(compile.code, 0) << compile.out;
