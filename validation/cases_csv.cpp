@@ -20,30 +20,6 @@ namespace {
 const char* const kColumns[15] = {"ox", "oy", "oz", "dx", "dy", "dz", "ax", "ay",
                                   "az", "bx", "by", "bz", "cx", "cy", "cz"};
 
-std::vector<std::string> split_fields(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char ch : line) {
-    if (ch == ',') out.push_back(cur), cur.clear();
-    else cur += ch;
-  }
-  out.push_back(cur);
-  for (auto& f : out) {
-    const auto b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
-    f = b == std::string::npos ? "" : f.substr(b, e - b + 1);
-  }
-  return out;
-}
-
-// The whole field must be one number (decimal or hex float).
-bool parse_double(const std::string& s, double& out) {
-  if (s.empty()) return false;
-  errno = 0;
-  char* end = nullptr;
-  out = std::strtod(s.c_str(), &end);
-  // Underflow to a subnormal is fine (an exported %a may be subnormal); overflow is not.
-  return end == s.c_str() + s.size() && !(errno == ERANGE && std::isinf(out));
-}
 
 std::string hex(double x) {
   char buf[64];
@@ -69,6 +45,31 @@ void check_unique_columns(const std::string& path, long lineno, const std::vecto
 }
 
 }  // namespace
+
+std::vector<std::string> split_fields(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char ch : line) {
+    if (ch == sep) out.push_back(cur), cur.clear();
+    else cur += ch;
+  }
+  out.push_back(cur);
+  for (auto& f : out) {
+    const auto b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
+    f = b == std::string::npos ? "" : f.substr(b, e - b + 1);
+  }
+  return out;
+}
+
+// The whole field must be one number (decimal or hex float).
+bool parse_double(const std::string& s, double& out) {
+  if (s.empty()) return false;
+  errno = 0;
+  char* end = nullptr;
+  out = std::strtod(s.c_str(), &end);
+  // Underflow to a subnormal is fine (an exported %a may be subnormal); overflow is not.
+  return end == s.c_str() + s.size() && !(errno == ERANGE && std::isinf(out));
+}
 
 std::vector<UserCase> read_cases_csv(const std::string& path) {
   std::vector<UserCase> cases;

@@ -48,4 +48,11 @@ std::string cases_csv(const std::vector<ExportRow>& rows);
 std::vector<ExportRow> export_rows(const std::vector<std::string>& families, Precision p,
                                    std::uint64_t seed, long long rays);
 
+// The fields of one CSV line split at `sep`, each trimmed of spaces and tabs
+// (shared by the cases and the graded answers readers).
+std::vector<std::string> split_fields(const std::string& line, char sep = ',');
+// True if the whole field is one number (decimal or hex float) that does not
+// overflow; underflow to a subnormal is accepted.
+bool parse_double(const std::string& s, double& out);
+
 }  // namespace ra::audit

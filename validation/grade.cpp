@@ -17,26 +17,6 @@ namespace ra::audit {
 
 namespace {
 
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out(1);
-  for (char ch : line) {
-    if (ch == sep) out.emplace_back();
-    else out.back() += ch;
-  }
-  for (auto& f : out) {
-    const auto b = f.find_first_not_of(" \t"), e = f.find_last_not_of(" \t");
-    f = b == std::string::npos ? "" : f.substr(b, e - b + 1);
-  }
-  return out;
-}
-
-bool number(const std::string& s, double& out) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  out = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size();
-}
-
 bool boolean(const std::string& s, bool& out) {
   if (s == "true" || s == "True" || s == "TRUE" || s == "1") return out = true, true;
   if (s == "false" || s == "False" || s == "FALSE" || s == "0") return out = false, true;
@@ -58,7 +38,7 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
   while (header.empty() && std::getline(in, line)) {
     ++lineno;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") != std::string::npos) header = split(line, ',');
+    if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
   }
   if (header.empty()) throw InputError(located(path, lineno, "empty file: expected a header line id,hit,t"));
   auto column = [&](const char* name) {
@@ -75,7 +55,7 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
     ++lineno;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
-    const auto f = split(line, ',');
+    const auto f = split_fields(line);
     if (f.size() != header.size())
       throw InputError(located(path, lineno, "expected " + std::to_string(header.size()) +
                                                  " fields as in the header, found " + std::to_string(f.size())));
@@ -87,10 +67,10 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
       throw InputError(located(path, lineno, "hit '" + f[std::size_t(hit)] + "' is not a boolean (true/false or 1/0)"));
     const std::string& ts = f[std::size_t(t)];
     if (g.answer.hit && ts.empty()) throw InputError(located(path, lineno, "a hit without t (id '" + key + "')"));
-    if (!ts.empty() && !number(ts, g.answer.t))
+    if (!ts.empty() && !parse_double(ts, g.answer.t))
       throw InputError(located(path, lineno, "t '" + ts + "' is not a number"));
     for (auto [c, name, out] : {std::tuple{u, "u", &g.answer.u}, {v, "v", &g.answer.v}})
-      if (c >= 0 && !f[std::size_t(c)].empty() && !number(f[std::size_t(c)], *out))
+      if (c >= 0 && !f[std::size_t(c)].empty() && !parse_double(f[std::size_t(c)], *out))
         throw InputError(located(path, lineno, std::string(name) + " '" + f[std::size_t(c)] + "' is not a number"));
     const auto [it, fresh] = out.emplace(key, g);
     if (!fresh)
@@ -102,7 +82,7 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
 
 // An exported id FAMILY:SWEEP:PROBE:K of a known family: the ray's key and K.
 bool group_id(const std::string& id, std::string& family, std::string& sweep, std::string& key, long& k) {
-  const auto parts = split(id, ':');
+  const auto parts = split_fields(id, ':');
   if (parts.size() != 4 || !find_family(parts[0])) return false;
   char* end = nullptr;
   k = std::strtol(parts[3].c_str(), &end, 10);
