@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "render.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace rb {
 

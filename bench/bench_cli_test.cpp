@@ -12,7 +12,7 @@
 #include <set>
 
 #include "run_rayaudit.h"
-#include "scene_mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace {
 

@@ -8,9 +8,9 @@
 #include <mutex>
 
 #include "bench.h"
-#include "camera.h"
+#include "scene/camera.h"
 #include "errors.h"
-#include "scene_mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace rb {
 

@@ -17,7 +17,7 @@
 #include <regex>
 #include <set>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "bench.h"
 #include "errors.h"
 #include "pov_runner.h"

@@ -1,4 +1,4 @@
-// Groups obj/FILE/serial|parallel (our OBJ parser, renderer/mesh.h) and
+// Groups obj/FILE/serial|parallel (our OBJ parser, renderer/formats/mesh.h) and
 // peer/tinyobjloader/FILE (tinyobjloader on the same file, each iteration
 // timing ours right before it): parse rate and peak heap bytes per triangle.
 // Ours maps the file read-only instead of copying it to the heap; tinyobj
@@ -8,8 +8,8 @@
 #include <tiny_obj_loader.h>
 
 #include "bench.h"
-#include "mesh.h"
-#include "scene_mesh.h"
+#include "formats/mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace rb {
 namespace {

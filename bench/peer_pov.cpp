@@ -13,7 +13,7 @@
 #include <regex>
 #include <sstream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "bench.h"
 #include "errors.h"
 #include "pov_export.h"

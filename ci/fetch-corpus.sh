@@ -67,7 +67,7 @@ copy() {
 # put SRC DEST: copy SRC to ladder/DEST unless present.
 put() { copy "$1" "ladder/$2"; }
 # A rayaudit run killed part way leaves its temporary (.tmp-RANDOM-NAME,
-# see renderer/atomic_file.h) beside the output it never renamed: removed
+# see renderer/io/atomic_file.h) beside the output it never renamed: removed
 # before that output is made again.
 drop_partial_output() { rm -f "$(dirname "$1")"/.tmp-*-"$(basename "$1")"; }
 # need_exe WHAT: stop unless rayaudit is built (our own converters need it).

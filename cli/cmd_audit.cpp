@@ -13,7 +13,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "audit.h"
 #include "cases_csv.h"
 #include "command.h"

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
 

@@ -11,7 +11,7 @@
 #include <iostream>
 #include <map>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "golden.h"
@@ -23,8 +23,8 @@
 #include "pov_tolerance.h"
 #include "random_scene.h"
 #include "render.h"
-#include "scene.h"
-#include "scene_mesh.h"
+#include "scene/scene.h"
+#include "scene/scene_mesh.h"
 
 namespace {
 

@@ -1,11 +1,11 @@
 // `rayaudit convert IN -o OUT.obj [--from ply|off]`: PLY (ascii / binary) or
-// OFF to OBJ by our own readers (renderer/polymesh_io.h), written atomically.
+// OFF to OBJ by our own readers (renderer/formats/polymesh_io.h), written atomically.
 #include <cstdio>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
-#include "polymesh_io.h"
+#include "formats/polymesh_io.h"
 
 namespace {
 

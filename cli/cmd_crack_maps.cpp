@@ -7,11 +7,11 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "crack_maps.h"
 #include "errors.h"
-#include "scene_mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace {
 

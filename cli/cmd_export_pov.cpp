@@ -3,12 +3,12 @@
 // the .pov under generated names; nothing from the scene is written as SDL.
 #include <iostream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "pov_export.h"
 #include "pov_runner.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace {
 

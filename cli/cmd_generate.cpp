@@ -19,7 +19,7 @@
 //     heights: 4 x 4 raised round domes (height = grey level) on a flat
 //       ground, for the height and pov bump variants.
 //     normals: the tangent-space normal map of the same domes (document 002's
-//       variant 1 as read in renderer/bump.h): RGB = (n + 1) / 2.
+//       variant 1 as read in renderer/shading/bump.h): RGB = (n + 1) / 2.
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -27,11 +27,11 @@
 #include <regex>
 #include <sstream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "image.h"
-#include "mesh.h"
+#include "formats/mesh.h"
 #include "vec.h"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.h"
-#include "mesh.h"
+#include "formats/mesh.h"
 
 namespace {
 

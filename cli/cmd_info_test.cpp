@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "../renderer/obj_test_util.h"
+#include "../renderer/formats/obj_test_util.h"
 
 namespace {
 

@@ -2,12 +2,12 @@
 #include <cstdint>
 #include <iostream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "registry.h"
 #include "render.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace {
 

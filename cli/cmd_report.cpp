@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "registry.h"

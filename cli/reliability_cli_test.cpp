@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "full_disk.h"
+#include "io/full_disk.h"
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;

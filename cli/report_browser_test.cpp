@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "run_rayaudit.h"
-#include "scene_mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace {
 

@@ -12,9 +12,9 @@
 #include <new>
 #include <string>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "errors.h"
-#include "input_file.h"
+#include "io/input_file.h"
 
 namespace ra {
 

@@ -12,15 +12,15 @@
 #include <fstream>
 #include <random>
 
-#include "bump.h"
+#include "shading/bump.h"
 #include "accel/bvh.h"
-#include "camera.h"
+#include "scene/camera.h"
 #include "image.h"
 #include "methods/areas.h"
 #include "registry.h"
 #include "render.h"
-#include "scene_mesh.h"
-#include "texture.h"
+#include "scene/scene_mesh.h"
+#include "shading/texture.h"
 
 namespace ra {
 namespace {

@@ -9,13 +9,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "errors.h"
-#include "full_disk.h"
+#include "io/full_disk.h"
 #include "image.h"
-#include "input_file.h"
-#include "json_input.h"
-#include "triangulate.h"
+#include "io/input_file.h"
+#include "io/json_input.h"
+#include "formats/triangulate.h"
 #include "workers.h"
 
 namespace fs = std::filesystem;

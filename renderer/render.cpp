@@ -13,15 +13,15 @@
 #include <thread>
 #include <type_traits>
 
-#include "bump.h"
+#include "shading/bump.h"
 #include "accel/bounding_sphere.h"
 #include "accel/bvh.h"
-#include "camera.h"
+#include "scene/camera.h"
 #include "errors.h"
 #include "methods/moller_simd.h"
 #include "pov_mesh.h"
 #include "registry.h"
-#include "texture.h"
+#include "shading/texture.h"
 #include "workers.h"
 
 namespace ra {

@@ -7,7 +7,7 @@
 
 #include "image.h"
 #include "ray.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "spawn.h"
 
 namespace ra {

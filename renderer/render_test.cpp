@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "camera.h"
+#include "scene/camera.h"
 #include "errors.h"
 
 namespace ra {

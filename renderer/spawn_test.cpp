@@ -24,7 +24,7 @@
 #include <random>
 
 #include "render.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace ra {
 namespace {

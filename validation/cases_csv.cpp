@@ -11,7 +11,7 @@
 
 #include "audit.h"
 #include "errors.h"
-#include "input_file.h"
+#include "io/input_file.h"
 
 namespace ra::audit {
 

@@ -9,13 +9,13 @@
 #include <mutex>
 #include <thread>
 
-#include "camera.h"
+#include "scene/camera.h"
 #include "errors.h"
 #include "families.h"
 #include "oracle.h"
 #include "registry.h"
 #include "render.h"
-#include "scene_mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace ra::crack {
 

@@ -7,11 +7,11 @@
 #include <set>
 #include <sstream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "errors.h"
-#include "json_input.h"
+#include "io/json_input.h"
 #include "render.h"
-#include "scene_mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace ra {
 namespace {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "image_compare.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace ra {
 

@@ -8,7 +8,7 @@
 #include <memory>
 #include <optional>
 
-#include "camera.h"
+#include "scene/camera.h"
 #include "pov_mesh.h"
 #include "spawn.h"
 

@@ -36,7 +36,7 @@
 #include "image.h"
 #include "image_compare.h"
 #include "render.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace ra {
 

@@ -10,7 +10,7 @@
 #include <map>
 #include <sstream>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "errors.h"
 
 namespace ra {

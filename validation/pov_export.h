@@ -1,6 +1,6 @@
 // Writes a scene as POV-Ray 3.7 SDL that renders the same image as our
 // tracer (../shared/POVRAY.md gives every rule followed here). It reads the
-// one scene model (renderer/scene.h): there is no second description.
+// one scene model (renderer/scene/scene.h): there is no second description.
 //
 // SDL can read and write files (#fopen, #write, #include, #read), so no text
 // from a scene ever reaches the SDL: image files are referred to by names we
@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace ra {
 

@@ -13,7 +13,7 @@
 #include <sstream>
 #include <vector>
 
-#include "atomic_file.h"
+#include "io/atomic_file.h"
 #include "errors.h"
 #include "pov_export.h"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "image.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace ra {
 

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "errors.h"
-#include "json_input.h"
+#include "io/json_input.h"
 
 namespace ra {
 

@@ -12,7 +12,7 @@
 #include <random>
 #include <sstream>
 
-#include "scene_mesh.h"
+#include "scene/scene_mesh.h"
 
 namespace ra {
 namespace {

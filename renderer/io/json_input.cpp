@@ -9,7 +9,7 @@
 #include <sstream>
 #include <vector>
 
-#include "errors.h"
+#include "../errors.h"
 #include "input_file.h"
 
 namespace ra {

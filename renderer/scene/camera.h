@@ -3,7 +3,7 @@
 //   dir = D + ((i + 0.5)/W - 0.5) R + (0.5 - (j + 0.5)/H) U,  normalised,
 // with |R| = W/H, |U| = 1 and |D| = 0.5 / tan(vfov / 2).
 #pragma once
-#include "ray.h"
+#include "../ray.h"
 #include "scene.h"
 
 namespace ra {

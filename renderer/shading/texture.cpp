@@ -4,8 +4,8 @@
 #include <new>
 #include <optional>
 
-#include "errors.h"
-#include "image.h"
+#include "../errors.h"
+#include "../image.h"
 
 namespace ra {
 namespace {

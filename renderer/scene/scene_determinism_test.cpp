@@ -6,8 +6,8 @@
 
 #include <filesystem>
 
-#include "errors.h"
-#include "render.h"
+#include "../errors.h"
+#include "../render.h"
 #include "scene.h"
 
 namespace fs = std::filesystem;

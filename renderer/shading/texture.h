@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "scene.h"
-#include "vec.h"
+#include "../scene/scene.h"
+#include "../vec.h"
 
 namespace ra {
 

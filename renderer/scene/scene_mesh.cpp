@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "errors.h"
+#include "../errors.h"
 
 namespace ra {
 

@@ -19,7 +19,7 @@
 #include <array>
 #include <vector>
 
-#include "vec.h"
+#include "../vec.h"
 
 namespace ra {
 

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "errors.h"
+#include "../errors.h"
 
 namespace ra {
 namespace {

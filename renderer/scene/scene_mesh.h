@@ -1,4 +1,4 @@
-// Placing an OBJ mesh in a scene: load (renderer/mesh.h), transform
+// Placing an OBJ mesh in a scene: load (renderer/formats/mesh.h), transform
 // (rotations in the order given, then uniform scale, then translation), and
 // map its MTL materials onto the tracer's POV-Ray finish (scenes/README.md).
 #pragma once
@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "mesh.h"
+#include "../formats/mesh.h"
 #include "scene.h"
 
 namespace ra {

@@ -9,7 +9,7 @@
 #include <random>
 #include <system_error>
 
-#include "errors.h"
+#include "../errors.h"
 
 namespace ra {
 

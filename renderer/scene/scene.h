@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "mesh.h"  // BoundingSphere (one definition for the loader and the scene)
-#include "vec.h"
+#include "../formats/mesh.h"  // BoundingSphere (one definition for the loader and the scene)
+#include "../vec.h"
 
 namespace ra {
 

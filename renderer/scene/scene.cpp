@@ -11,9 +11,9 @@
 #include <set>
 #include <sstream>
 
-#include "errors.h"
-#include "input_file.h"
-#include "json_input.h"
+#include "../errors.h"
+#include "../io/input_file.h"
+#include "../io/json_input.h"
 #include "scene_mesh.h"
 
 namespace ra {

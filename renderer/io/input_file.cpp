@@ -4,7 +4,7 @@
 
 #include <system_error>
 
-#include "errors.h"
+#include "../errors.h"
 
 namespace ra {
 

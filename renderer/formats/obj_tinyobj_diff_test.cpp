@@ -22,7 +22,7 @@
 #include <set>
 #include <sstream>
 
-#include "errors.h"
+#include "../errors.h"
 #include "mesh.h"
 
 namespace ra {

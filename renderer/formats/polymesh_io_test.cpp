@@ -3,7 +3,7 @@
 
 #include <cstring>
 
-#include "errors.h"
+#include "../errors.h"
 #include "mesh.h"
 #include "polymesh_io.h"
 

@@ -32,7 +32,7 @@
 #pragma once
 #include <optional>
 
-#include "scene.h"
+#include "../scene/scene.h"
 #include "texture.h"
 
 namespace ra {

@@ -48,7 +48,7 @@
 #include <string_view>
 #include <vector>
 
-#include "vec.h"
+#include "../vec.h"
 
 namespace ra {
 

@@ -54,10 +54,10 @@
 #endif
 
 #include "mesh.h"
-#include "input_file.h"
+#include "../io/input_file.h"
 #include "obj_text.h"
 #include "triangulate.h"
-#include "workers.h"
+#include "../workers.h"
 
 namespace ra {
 namespace {

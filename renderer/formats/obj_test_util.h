@@ -8,7 +8,7 @@
 #include <string>
 #include <unistd.h>
 
-#include "errors.h"
+#include "../errors.h"
 #include "mesh.h"
 
 namespace ra::test {

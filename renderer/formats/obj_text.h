@@ -12,7 +12,7 @@
 #include <string>
 #include <string_view>
 
-#include "errors.h"
+#include "../errors.h"
 #include "mesh.h"
 
 namespace ra::objtext {

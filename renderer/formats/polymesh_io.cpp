@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <cstring>
 
-#include "atomic_file.h"
-#include "errors.h"
+#include "../io/atomic_file.h"
+#include "../errors.h"
 #include "mesh.h"
 
 namespace ra {

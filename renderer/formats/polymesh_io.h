@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "vec.h"
+#include "../vec.h"
 
 namespace ra {
 
