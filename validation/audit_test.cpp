@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <cstdio>
@@ -234,6 +235,33 @@ TEST(AuditFamilies, ClosedMeshRaysCrossTheSurfaceExactlyOnce) {
         ts.erase(std::unique(ts.begin(), ts.end()), ts.end());
         ASSERT_EQ(ts.size(), 1u) << f.sweep[std::size_t(s)] << " " << precision_name(p) << " ray " << pc.ray.o;
       }
+}
+
+TEST(AuditFamilies, DistanceMovesOnlyTheTriangleAndAboutAThirdOfItsRaysHit) {
+  // The ray starts in the cube of half-size 4 about the origin; the triangle
+  // (vertices in the unit cube) is moved the sweep's distance away. Rays are
+  // aimed inside the triangle's box, so the exact oracle says a fair share
+  // of them hit (a triangle fills about a third of its box's projection).
+  const Family& f = *find_family("distance");
+  for (int s = 0; s < int(f.sweep.size()); ++s) {
+    const double distance = std::stod(f.sweep[std::size_t(s)]);
+    TriangleBatch b;
+    generate(f, s, Precision::f64, stream_seed(4, f.name, s, 0), 500, b);
+    ASSERT_EQ(b.probes.size(), 500u);
+    for (const Probe& pr : b.probes) {
+      ASSERT_LE(std::max({std::abs(pr.ray.o.x), std::abs(pr.ray.o.y), std::abs(pr.ray.o.z)}), 4.0);
+      const Tri& t = b.tris[std::size_t(pr.first)];
+      const ra::Vec3d c = (t.a + t.b + t.c) * (1.0 / 3);
+      ASSERT_NEAR(std::sqrt(ra::dot(c, c)), distance, 2.0) << f.sweep[std::size_t(s)];
+    }
+    std::size_t hits = 0, total = 0;
+    for (const ProbeCase& pc : probe_cases(f, s, Precision::f64, 4, 2000)) {
+      ++total;
+      hits += pc.answers[0].verdict == Verdict::hit;
+    }
+    EXPECT_GT(hits, total / 5) << f.sweep[std::size_t(s)];
+    EXPECT_LT(hits, total / 2) << f.sweep[std::size_t(s)];
+  }
 }
 
 TEST(AuditFamilies, DegenerateFamilyIsExactlyDegenerate) {

@@ -1,4 +1,4 @@
-// Case families (issue 6): random, edge, vertex, grazing, offset, scale,
+// Case families (issue 6): random, edge, vertex, grazing, offset, distance, scale,
 // sliver, near-miss, degenerate, closed-mesh (Embree's WatertightTest placement), secondary; spheres huge, tiny-far, near-origin.
 #include "families.h"
 
@@ -50,6 +50,9 @@ void frame(const Vec3d& e, Vec3d& u, Vec3d& w) {
 // ------------------------------------------------------------- sweeps ---
 const std::vector<double> kOffsets = {0, 1e1, 1e3, 1e5, 1e7};
 const std::vector<double> kOffsetFamily = {1, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7};
+// distance: the triangle alone is moved this far; the ray still starts near
+// the origin, as a camera's primary ray does (offset moves both).
+const std::vector<double> kTriangleDistances = {1e1, 1e2, 1e3, 1e4, 1e5, 1e6};
 const std::vector<double> kAngles = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
 const std::vector<double> kScaleLo = {1e-8, 1e-4, 1, 1e4};  // each bucket spans 4 decades
 const std::vector<double> kAspects = {1e1, 1e2, 1e3, 1e4, 1e5, 1e6};
@@ -221,6 +224,22 @@ void random_case(Rng& g, double spread, double scale, const Vec3d& offset, Trian
 }
 
 Vec3d random_offset(Rng& g, double magnitude) { return g.unit() * magnitude; }
+
+// A random triangle of size about 1 moved `distance` away in a random
+// direction, and a ray from near the origin aimed inside its box. Long rays
+// to small triangles are where conservative error bounds on t bite: pbrt-v4's
+// watertight test rejects t <= deltaT (Woop et al. 2013 with pbrt's bounds),
+// and deltaT grows with the triangle's distance while the edge functions
+// shrink with its size (the crack maps showed float watertight missing a
+// whole small triangle about 1e5 away).
+void distant_case(Rng& g, double distance, TriangleBatch& b) {
+  const Tri t{g.in_cube(1), g.in_cube(1), g.in_cube(1)};
+  const Vec3d lo = vmin(t.a, vmin(t.b, t.c)), hi = vmax(t.a, vmax(t.b, t.c));
+  const Vec3d aim = (lo + hi) * 0.5 + mul((hi - lo) * 0.5, g.in_cube(1));
+  const Vec3d o = g.in_cube(4);
+  const Vec3d off = random_offset(g, distance);
+  add_single(b, {t.a + off, t.b + off, t.c + off}, aimed(o, aim + off));
+}
 
 // A segment from p (on the grid) of m equal grid vectors e toward a random
 // point of the cube of half-size `size` about `centre`: every p + j e is a
@@ -491,6 +510,7 @@ const std::vector<Family>& families() {
     add("vertex", Kind::triangle, "offset", labels(kOffsets), true);
     add("grazing", Kind::triangle, "angle (rad)", labels(kAngles));
     add("offset", Kind::triangle, "offset", labels(kOffsetFamily));
+    add("distance", Kind::triangle, "distance", labels(kTriangleDistances));
     add("scale", Kind::triangle, "scale from", labels(kScaleLo));
     add("sliver", Kind::triangle, "aspect", labels(kAspects));
     add("near-miss", Kind::triangle, "ulps outside", labels(kNearMissUlps));
@@ -547,6 +567,7 @@ void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int
       else if (f.name == "vertex") vertex_case(g, kOffsets[s], p, out);
       else if (f.name == "grazing") grazing_case(g, kAngles[s], out);
       else if (f.name == "offset") random_case(g, 1, 1, random_offset(g, kOffsetFamily[s]), out);
+      else if (f.name == "distance") distant_case(g, kTriangleDistances[s], out);
       else if (f.name == "scale") random_case(g, 1, g.log_uniform(kScaleLo[s], kScaleLo[s] * 1e4), {}, out);
       else if (f.name == "sliver") sliver_case(g, kAspects[s], out);
       else if (f.name == "near-miss") near_miss_case(g, kNearMissUlps[s], p, out);
