@@ -16,9 +16,18 @@ namespace ra {
 namespace {
 
 // The scene as POV-Ray's mesh2 holds it: with `float32`, every mesh's
-// vertices, normals and UVs rounded to float32; with `flatten`, each smooth
-// triangle whose three normals are equal made flat (given the normal of its
-// vertices), as POV-Ray does.
+// vertices and normals rounded to float32 (SNGL_VECT; its UVs are double,
+// UV_VECT); with `flatten`, each smooth triangle POV-Ray makes flat (given
+// the normal of its vertices): Parse_Mesh2's "check for equal normals" calls
+// a triangle flat when |N1 - N2|^2 and |N1 - N3|^2 are both at most EPSILON
+// (1e-10), the differences taken of the float32 normals.
+// Parse_Mesh2's test on two normals (float32 values): VSub of two float
+// vectors subtracts in float, VDot sums the squares in double.
+bool pov_equal_normals(const Vec3d& a, const Vec3d& b) {
+  const Vec3d d = to_float32(a - b);
+  return !(std::fabs(dot(d, d)) > 1e-10);
+}
+
 Scene as_pov_stores_it(const Scene& scene, bool float32, bool flatten) {
   Scene s = scene;
   for (auto& o : s.objects) {
@@ -47,13 +56,12 @@ Scene as_pov_stores_it(const Scene& scene, bool float32, bool flatten) {
         const double len = length(n);
         if (len > 0) n = to_float32(n / len);
       }
-      for (auto& uv : set->uvs) uv = {to_float32(uv[0]), to_float32(uv[1])};
     }
     if (flatten && set->shading == Shading::smooth) {
       for (auto& tri : set->triangles) {
         if (tri.n[0] < 0 || tri.n[1] < 0 || tri.n[2] < 0) continue;
         const Vec3d &na = set->normals[tri.n[0]], &nb = set->normals[tri.n[1]], &nc = set->normals[tri.n[2]];
-        if (!(na == nb && nb == nc)) continue;
+        if (!(pov_equal_normals(na, nb) && pov_equal_normals(na, nc))) continue;
         const Vec3d &a = set->positions[tri.v[0]], &b = set->positions[tri.v[1]], &c = set->positions[tri.v[2]];
         Vec3d g = normalize(cross(b - a, c - a));
         if (dot(g, na) < 0) g = -g;
@@ -95,15 +103,17 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
     RenderOptions options;
   };
   const Model models[] = {
-      {"float32: with the mesh's vertices, normals and UVs rounded to float32, as POV-Ray's mesh2 stores them, "
-       "our pixel equals POV-Ray's",
+      {"float32: with the mesh's vertices and normals rounded to float32, as POV-Ray's mesh2 stores them "
+       "(SNGL_VECT; its UVs are double), our pixel equals POV-Ray's",
        as_pov_stores_it(scene, true, false), quiet},
-      {"equal normals: POV-Ray makes a triangle whose three normals are equal flat, with the normal of its "
-       "vertices rather than the given one; done so (and with float32 mesh data), our pixel equals POV-Ray's",
+      {"equal normals: POV-Ray makes a triangle flat, with the normal of its vertices rather than the given ones, "
+       "when its three float32 normals are equal within |N1 - N2|^2 <= 1e-10 and |N1 - N3|^2 <= 1e-10 "
+       "(Parse_Mesh2); done so (and with float32 mesh data), our pixel equals POV-Ray's",
        as_pov_stores_it(scene, true, true), quiet},
       {"mesh2 hit point: POV-Ray puts the hit at O + t D with t from the triangle's plane stored as float32 (its "
        "unit normal and distance), off the plane of the vertices, and interpolates the smooth normal there "
-       "through its float32 Perp vector (shape/mesh.cpp); done so (with float32 mesh data and equal normals "
+       "through its Perp vector, computed in float32 step by step (compute_smooth_triangle of shape/mesh.cpp, "
+       "the SNGL_VECT overloads of math/vector.h); done so (with float32 mesh data and equal normals "
        "flat), our pixel equals POV-Ray's",
        as_pov_stores_it(scene, true, true), pov_hit},
       {"mesh2 intersection: POV-Ray decides whether a ray meets a mesh2 triangle by projecting the point on its "
