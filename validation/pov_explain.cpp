@@ -154,16 +154,6 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
        models[kAllMeshRules].scene, models[kAllMeshRules].options},
   };
   std::optional<Image> cache_images[std::size(cache_models)];
-  std::unique_ptr<Tracer> uv_tracers[4];
-  {
-    constexpr double kUv = 1.0 / (1 << 22);
-    const std::array<double, 2> offsets[4] = {{kUv, 0}, {-kUv, 0}, {0, kUv}, {0, -kUv}};
-    for (int k = 0; k < 4; ++k) {
-      RenderOptions o = models[kAllMeshRules].options;
-      o.uv_offset = offsets[k];
-      uv_tracers[k] = std::make_unique<Tracer>(models[kAllMeshRules].scene, o);
-    }
-  }
   const Tracer tracer(scene, quiet);
   const Camera camera(scene.camera, scene.width, scene.height);
   const unsigned m = c.bits == 16 ? 65535u : 255u;
@@ -175,21 +165,6 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
       bool same = true;
       for (int ch = 0; ch < 3; ++ch) same &= quantize(rf[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
       if (same) e.cause = models[mi].cause;
-    }
-    // Texture lookups this close to a texel boundary (or this sensitive)
-    // are decided below the precision of POV's float32 mesh data: with every
-    // mesh2 rule, the lookup moved by 2^-22 in u or v (4 float32 ulps of a
-    // coordinate near 1) gives POV's pixel.
-    for (std::size_t k = 0; k < std::size(uv_tracers) && e.cause.empty(); ++k) {
-      const Color rc = uv_tracers[k]->pixel(d.x, d.y);
-      const float rf[3] = {float(rc.x), float(rc.y), float(rc.z)};
-      bool same = true;
-      for (int ch = 0; ch < 3; ++ch) same &= quantize(rf[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
-      if (same)
-        e.cause =
-            "float32 UV precision: the pixel's texture lookup is decided below the precision of POV-Ray's float32 "
-            "mesh data: with every mesh2 rule and the lookup moved by 2^-22 in u or v (4 float32 ulps near 1), our "
-            "pixel equals POV-Ray's";
     }
     // POV's shadow cache: the whole image rendered in POV's order with it
     // (its state runs from pixel to pixel), alone and with every rule above.
