@@ -20,15 +20,18 @@ ci/fetch-corpus.sh "$RAYAUDIT"
 failed=0
 for seed in "${SEEDS[@]}"; do
   step "random batch: rayaudit compare --random $N --seed $seed --out $OUT/random-$seed"
-  rc=0
+  rc=0 started=$SECONDS
   nice "$RAYAUDIT" compare --random "$N" --seed "$seed" --out "$OUT/random-$seed" \
     >"$OUT/random-$seed.log" 2>/dev/null || rc=$?
   grep -Ev ': identical$' "$OUT/random-$seed.log" || true
+  echo "seed $seed: $((SECONDS - started)) s"
   [ "$rc" = 0 ] || failed=1
 done
 
 step "corpus sweep: every OBJ in the cache against POV-Ray (ci/pov-sweep.sh)"
+started=$SECONDS
 ci/pov-sweep.sh "$RAYAUDIT" "$OUT/pov-sweep" || failed=1
+echo "corpus sweep: $((SECONDS - started)) s"
 
 step "done: outputs in $OUT"
 exit $failed
