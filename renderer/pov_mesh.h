@@ -13,7 +13,9 @@
 // the ray. The smooth normal is interpolated at that point through the float
 // vector `Perp` of compute_smooth_triangle (after the vertex swap of
 // Compute_Mesh_Triangle): u = (P - P1).Perp, and below 1e-10 the normal is
-// N1's alone.
+// N1's alone. Perp is a float vector whose every step (the difference, its
+// normalisation, the division by -uDenominator) is done in float by the
+// SNGL_VECT overloads of math/vector.h; the UVs (UV_VECT) are double.
 //
 // Where the smooth normals vary fast (small triangles on a curved surface),
 // that moves N.L by 1e-6 to 1e-4, enough to cross an 8-bit rounding boundary:

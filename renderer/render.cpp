@@ -538,7 +538,7 @@ struct Tracer::Impl {
     const Material& m = *s.material;
     if (m.texture && s.has_uv)
       if (const Texture* t = textures.find(m.texture->file))
-        return t->sample(s.u + opt.uv_offset[0], s.v + opt.uv_offset[1], m.texture->filter);
+        return t->sample(s.u, s.v, m.texture->filter);
     return m.color;
   }
 

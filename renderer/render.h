@@ -61,10 +61,6 @@ struct RenderOptions {
   // angle), skipped: whether it happens is decided by the last bits of the
   // hit point, which POV-Ray computes differently. A hypothesis for --explain.
   bool skip_rounding_self_hits = false;
-  // Added to every texture lookup's (u, v): --explain moves lookups by less
-  // than POV-Ray's float32 mesh data can place them, to show a pixel decided
-  // below that precision. Zero to render.
-  std::array<double, 2> uv_offset{0, 0};
 };
 
 // What a ray hit: object index, primitive (triangle) index, t and the

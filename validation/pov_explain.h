@@ -1,13 +1,15 @@
 // Names the likely cause of each pixel where our render and POV-Ray's
 // differ, by testing the known causes (../shared/POVRAY.md):
-//  - float32: POV stores mesh2 vertices, normals and UVs as float32. We
-//    render again with the mesh data rounded to float32; if the pixel then
-//    equals POV's, that rounding is the cause.
-//  - equal normals: POV makes a smooth triangle whose three normals are
-//    equal flat, with its geometric normal (and float32 data).
+//  - float32: POV stores mesh2 vertices and normals as float32 (its UVs
+//    are double). We render again with them rounded to float32; if the
+//    pixel then equals POV's, that rounding is the cause.
+//  - equal normals: POV makes a smooth triangle whose three float32 normals
+//    are equal within |N1 - N2|^2 <= 1e-10 and |N1 - N3|^2 <= 1e-10 flat,
+//    with its geometric normal (and float32 data).
 //  - mesh2 hit point: POV's hit point is O + t D with t from the triangle's
 //    float32 plane, and the smooth normal is interpolated there through its
-//    float32 Perp vector (renderer/pov_mesh.h); rendered so, with the two
+//    Perp vector, computed in float32 step by step (renderer/pov_mesh.h:
+//    pov_perp); rendered so, with the two
 //    models above.
 //  - mesh2 intersection: which triangle a ray meets decided by POV's own
 //    test (dominant-axis projection on float32 data, renderer/pov_mesh.h)
