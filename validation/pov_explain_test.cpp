@@ -13,8 +13,8 @@
 #include "image_compare.h"
 #include "pov_runner.h"
 #include "golden.h"
-#include "scene.h"
-#include "scene_mesh.h"
+#include "scene/scene.h"
+#include "scene/scene_mesh.h"
 
 namespace ra {
 namespace {
