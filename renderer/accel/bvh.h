@@ -36,6 +36,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "../vec.h"
@@ -129,6 +130,11 @@ struct BoxRay {
   // tmin >= 0 (every ray the tracer casts): then tnear >= 0, and tfar may
   // carry all the slack (Ize 2013's one-sided test, 2 operations fewer).
   bool nonneg = false;
+  // The fused form (meet8_fma): oi = o * inv rounded to float, and
+  // abs_slack = 3 E with E above its rounding error (see meet8_fma). Usable
+  // when exact, nonneg, and every inv and oi finite (no d_a = 0).
+  v8f oi[3], abs_slack;
+  bool fma_ok = false;
 };
 
 // One vector division for the three 1/d_a: in float for float rays (the
@@ -162,6 +168,15 @@ template <class T>
   const float tmin_f = round_down(double(tmin));
   b.tmin = splat(tmin_f);
   b.nonneg = tmin_f >= 0;
+  const v4 oi = of * inv, abs_oi = (v4)((v4m)oi & 0x7FFFFFFF);
+  const v4m finite = (abs_inv <= std::numeric_limits<float>::max()) & (abs_oi <= std::numeric_limits<float>::max());
+  b.fma_ok = b.exact && b.nonneg && (_mm_movemask_ps((__m128)finite) & 7) == 7;
+  // E = 2^-22 (|oi_x| + |oi_y| + |oi_z|) + 2^-126 bounds each |o_a inv_a -
+  // oi_a| (at most half an ulp of oi_a, or 2^-150 where oi_a is subnormal)
+  // with room for this sum's own roundings.
+  const float e = (abs_oi[0] + abs_oi[1] + abs_oi[2]) * 0x1p-22f + 0x1p-126f;
+  for (int a = 0; a < 3; ++a) b.oi[a] = splat(oi[a]);
+  b.abs_slack = splat(3 * e);
   return b;
 }
 
@@ -197,57 +212,126 @@ template <class T>
   return movemask(tnear <= far_up);
 }
 
+// a * b - c and a * b + c rounded once, and the sign bits of 8 lanes: one
+// AVX2/FMA instruction each. Written as assembly because the traversal is
+// generic code inlined into the tracer's AVX2+FMA entry points (GCC does
+// not inline target-specific intrinsics into it); only those entry points
+// instantiate them (traverse's kFma).
+[[gnu::always_inline]] inline v8f fmsub(v8f a, v8f b, v8f c) {
+  asm("vfmsub213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
+  return a;
+}
+[[gnu::always_inline]] inline v8f fmadd(v8f a, v8f b, v8f c) {
+  asm("vfmadd213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
+  return a;
+}
+[[gnu::always_inline]] inline int movemask_avx(v8i m) {
+  int r;
+  asm("vmovmskps %1, %0" : "=r"(r) : "x"(m));
+  return r;
+}
+
+// meet8 with one fused multiply-subtract per plane, t = p inv - oi, for
+// rays with fma_ok (Embree's form; here made conservative). Against
+// meet8's fl(fl(p - o) inv) it rounds once where meet8 rounds twice, and
+// adds the absolute error d_a = o_a inv_a - oi_a (|d_a| <= E / 4):
+// t' = ((p - o) inv + d_a)(1 + e), |e| <= 2^-24. With s the relative slack
+// of meet8 and tmin >= 0, every axis's entry t' <= tnear (1 + s) + E and
+// exit t' >= tfar (1 - s) - E, so a box the exact segment meets has
+// tn' - E <= (tf' + E)(1 + s) / (1 - s): the test tn' <= tf' (1 + 4 s) + 3 E
+// (fused, so rounded once, down by at most 2^-24 relative, inside the 4 s)
+// never rejects it. tnear = tn' for pruning against tmax (1 + 4 s) + 3 E.
+[[gnu::always_inline]] inline int meet8_fma(const BvhNode& n, const BoxRay& r, v8f tmax, v8f& tnear) {
+  const char* base = reinterpret_cast<const char*>(&n);
+  v8f t0[3], t1[3];
+  for (int a = 0; a < 3; ++a) {
+    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), r.inv[a], r.oi[a]);
+    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), r.inv[a], r.oi[a]);
+  }
+  // No NaN here: inv and oi are finite and nonzero-safe (empty children's
+  // +-inf planes give +-inf).
+  const v8f n01 = t0[0] > t0[1] ? t0[0] : t0[1], n2 = t0[2] > r.tmin ? t0[2] : r.tmin;
+  const v8f f01 = t1[0] < t1[1] ? t1[0] : t1[1], f2 = t1[2] < tmax ? t1[2] : tmax;
+  const v8f tn = n01 > n2 ? n01 : n2, tf = f01 < f2 ? f01 : f2;
+  tnear = tn;
+  return movemask_avx(tn <= fmadd(tf, splat(1 + 4 * Bvh::kRelSlack), r.abs_slack));
+}
+
 #pragma GCC diagnostic pop
 
 }  // namespace bvh_detail
 
-// Visits the leaves whose boxes the ray's window meets; `leaf(first_slot,
-// count)` returns true to stop. kClosest: nearest box first, `tmax` re-read
-// after every leaf (closest-hit shrinks it) and boxes entered beyond it
-// skipped; otherwise (any hit) in node order, without sorting. The nearest
-// child hit is visited next without going through the stack.
-// Always inlined, so that it is compiled for the ISA of its caller.
-template <bool kClosest, class T, class Leaf>
-[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
-                                            Leaf&& leaf) {
-  using namespace bvh_detail;
-  if (bvh.nodes.empty()) return;
-  const BoxRay r = box_ray(o, d, tmin);
+namespace bvh_detail {
+
+// traverse's loop for one box test: kFused, meet8_fma (the ray has
+// fma_ok); otherwise meet8, or every child where float cannot hold the ray.
+template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
+[[gnu::always_inline]] inline void traverse_loop(const Bvh& bvh, const BoxRay& r, const T& tmax, Leaf&& leaf,
+                                                 LeafPrefetch&& leaf_prefetch) {
+  // Closest hit keeps each pushed box's tnear to skip it later; any hit
+  // needs only the node.
   struct Entry {
     std::uint32_t node;
     float tnear;
   };
-  Entry stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
+  using Slot = std::conditional_t<kClosest, Entry, std::uint32_t>;
+  Slot stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
   int top = 0;
   float tmax_f = round_up(double(tmax));
-  // What a box's tnear must exceed to be skipped (see meet8).
+  v8f tmax_v = splat(tmax_f);
+  // What a box's tnear must exceed to be skipped (see meet8, meet8_fma).
   const float prune_scale = r.nonneg ? 1 + 4 * Bvh::kRelSlack : 1.f;
-  float prune = tmax_f * prune_scale;
+  const float prune_add = kFused ? r.abs_slack[0] : 0.f;
+  auto prune_of = [&](float t) __attribute__((always_inline)) {
+    if constexpr (kFused) return __builtin_fmaf(t, prune_scale, prune_add);
+    else return t * prune_scale;
+  };
+  float prune = prune_of(tmax_f);
   std::uint32_t cur = 0;  // the root is a node (a lone leaf gets one)
   for (;;) {
     if (Bvh::is_leaf(cur)) {
       if (leaf(Bvh::leaf_first(cur), Bvh::leaf_count(cur))) return;
       if constexpr (kClosest) {
         tmax_f = round_up(double(tmax));
-        prune = tmax_f * prune_scale;
+        tmax_v = splat(tmax_f);
+        prune = prune_of(tmax_f);
       }
     } else {
       const BvhNode& n = bvh.nodes[cur];
       alignas(32) float tn[8];
       int mask;
-      if (r.exact) {
+      {
         v8f tnv;
-        mask = meet8(n, r, tmax_f, tnv);
-        __builtin_memcpy(tn, &tnv, sizeof tn);
-      } else {
-        mask = 0;
-        for (int i = 0; i < 8; ++i) {
-          mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
-          tn[i] = -INFINITY;
+        if constexpr (kFused) {
+          mask = meet8_fma(n, r, tmax_v, tnv);
+        } else if (r.exact) {
+          mask = meet8(n, r, tmax_f, tnv);
+        } else {
+          mask = 0;
+          for (int i = 0; i < 8; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
+          tnv = splat(-INFINITY);
         }
+        if constexpr (kClosest) __builtin_memcpy(tn, &tnv, sizeof tn);
       }
       if (mask) {
-        int i = __builtin_ctz(unsigned(mask));
+#ifndef RA_BVH_NO_PREFETCH
+        // Ask for every child met now: its node's lines, or its leaf's data
+        // (Embree does the same); the loads overlap instead of following
+        // one another down the tree.
+        for (int m = mask; m; m &= m - 1) {
+          const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
+          if (Bvh::is_leaf(c)) {
+            leaf_prefetch(Bvh::leaf_first(c));
+          } else {
+            const char* p = reinterpret_cast<const char*>(&bvh.nodes[c]);
+            __builtin_prefetch(p);
+            __builtin_prefetch(p + 64);
+            __builtin_prefetch(p + 128);
+            __builtin_prefetch(p + 192);
+          }
+        }
+#endif
+        const int i = __builtin_ctz(unsigned(mask));
         mask &= mask - 1;
         if (!mask) {  // one child: straight to it
           cur = n.child[i];
@@ -255,19 +339,24 @@ template <bool kClosest, class T, class Leaf>
         }
         if constexpr (!kClosest) {
           cur = n.child[i];
-          for (; mask; mask &= mask - 1) {
-            const int j = __builtin_ctz(unsigned(mask));
-            stack[top++] = {n.child[j], tn[j]};
-          }
+          for (; mask; mask &= mask - 1) stack[top++] = n.child[__builtin_ctz(unsigned(mask))];
           continue;
         } else {
-          // Push all hit children sorted so the nearest is on top, then
-          // take it.
+          const int j = __builtin_ctz(unsigned(mask));
+          mask &= mask - 1;
+          if (!mask) {  // two children (the usual case): the nearer first
+            const bool swap = tn[j] < tn[i];
+            const int nearer = swap ? j : i, farther = swap ? i : j;
+            stack[top++] = {n.child[farther], tn[farther]};
+            cur = n.child[nearer];
+            continue;
+          }
+          // More: push all sorted so the nearest is on top, then take it.
           const int base = top;
           stack[top++] = {n.child[i], tn[i]};
-          for (; mask; mask &= mask - 1) {
-            const int j = __builtin_ctz(unsigned(mask));
-            const Entry c{n.child[j], tn[j]};
+          for (mask |= 1 << j; mask; mask &= mask - 1) {
+            const int k0 = __builtin_ctz(unsigned(mask));
+            const Entry c{n.child[k0], tn[k0]};
             int k = top++;
             while (k > base && stack[k - 1].tnear < c.tnear) {
               stack[k] = stack[k - 1];
@@ -281,14 +370,47 @@ template <bool kClosest, class T, class Leaf>
       }
     }
     // Next from the stack, skipping boxes entered beyond the closest hit.
-    for (;;) {
+    if constexpr (kClosest) {
+      for (;;) {
+        if (top == 0) return;
+        const Entry e = stack[--top];
+        if (e.tnear > prune) continue;
+        cur = e.node;
+        break;
+      }
+    } else {
       if (top == 0) return;
-      const Entry e = stack[--top];
-      if (kClosest && e.tnear > prune) continue;
-      cur = e.node;
-      break;
+      cur = stack[--top];
     }
   }
+}
+
+}  // namespace bvh_detail
+
+// Visits the leaves whose boxes the ray's window meets; `leaf(first_slot,
+// count)` returns true to stop, `leaf_prefetch(first_slot)` may ask for a
+// leaf's data when its box is met. kClosest: nearest box first, `tmax`
+// re-read after every leaf (closest-hit shrinks it) and boxes entered
+// beyond it skipped; otherwise (any hit) in node order, without sorting.
+// The nearest child hit is visited next without going through the stack.
+// Always inlined, so that it is compiled for the ISA of its caller; kFma
+// only from callers compiled for AVX2 and FMA (meet8_fma's instructions).
+template <bool kClosest, bool kFma = false, class T, class Leaf, class LeafPrefetch>
+[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
+                                            Leaf&& leaf, LeafPrefetch&& leaf_prefetch) {
+  using namespace bvh_detail;
+  if (bvh.nodes.empty()) return;
+  const BoxRay r = box_ray(o, d, tmin);
+  if constexpr (kFma) {
+    if (r.fma_ok) return traverse_loop<kClosest, true>(bvh, r, tmax, leaf, leaf_prefetch);
+  }
+  traverse_loop<kClosest, false>(bvh, r, tmax, leaf, leaf_prefetch);
+}
+
+template <bool kClosest, bool kFma = false, class T, class Leaf>
+[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
+                                            Leaf&& leaf) {
+  traverse<kClosest, kFma>(bvh, o, d, tmin, tmax, leaf, [](std::uint32_t) {});
 }
 
 }  // namespace ra

@@ -58,6 +58,15 @@ template <class T>
   return v;
 }
 
+// Is any lane of a comparison's mask set?
+template <class T>
+[[gnu::always_inline]] inline bool any_lane(typename Lanes<T>::M m) {
+  std::int64_t w[sizeof m / 8];
+  __builtin_memcpy(w, &m, sizeof m);
+  if constexpr (sizeof m == 16) return (w[0] | w[1]) != 0;
+  else return ((w[0] | w[1]) | (w[2] | w[3])) != 0;
+}
+
 template <class T>
 [[gnu::always_inline]] inline void hit4(const Ray<T>& r, const Tri4<T>& tri, bool cull, Hit4<T>& out) {
   using V = typename Lanes<T>::V;
@@ -75,6 +84,13 @@ template <class T>
   const V sx = (V{} + r.o.x) - ax, sy = (V{} + r.o.y) - ay, sz = (V{} + r.o.z) - az;
   const V u = (sx * px + sy * py + sz * pz) * inv;
   ok &= (u >= V{}) & (u <= V{} + T(1));
+  // Most leaf tests miss every lane by here (shadow rays leaving the
+  // surface, rays passing a leaf's box): skip the rest, whose only effect
+  // is to reject more lanes.
+  if (!any_lane<T>(ok)) {
+    out.hits = 0;
+    return;
+  }
   // q = cross(s, e1)
   const V qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
   const V v = (dx * qx + dy * qy + dz * qz) * inv;
