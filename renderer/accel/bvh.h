@@ -20,18 +20,20 @@
 //    <= 2^-24 * 2 size, far below the padding; farther out every box plane
 //    is at least |o_a| / 2 away, so the error is at most 2^-23 relative to
 //    (plane - o_a), i.e. relative in t;
-//  - 1/d rounded to float (from double for double rays), the subtraction
-//    and the product add 3 roundings:
+//  - d rounded to float (double rays), 1/d in float, the subtraction and
+//    the product add 4 roundings (the fused test of meet8_fma: 3, plus an
+//    absolute term bounded per ray):
 //    all of it is relative to t, covered by widening [tnear, tfar] by
 //    kRelSlack = 2^-20 (16 float ulps) of their magnitudes;
 //  - d_a = 0 gives 1/d_a = +-inf: (plane - o_a) * inf is +-inf, or NaN when
 //    o_a lies exactly on the plane, which the min/max below ignore (the slab
 //    then constrains nothing), as Williams et al. 2005 intend;
-//  - a ray float cannot hold (|o| > 1e30, |1/d| below float's normal range
-//    or above it while d != 0) visits every leaf instead.
+//  - a ray float cannot hold (|o| > 1e30, |d| or |1/d| outside float's
+//    normal range while d != 0) visits every leaf instead.
 #pragma once
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -119,13 +121,15 @@ inline float round_up(double x) {
   return f > 1e-30f ? f * (1 + 0x1p-23f) : f < -1e-30f ? f * (1 - 0x1p-23f) : f + 1e-30f;
 }
 
-// The ray as the box test sees it.
+// The ray as the box test sees it: scalars, broadcast where used (a
+// broadcast from memory costs a load; eleven 8-lane copies per ray cost
+// more than the boxes a missing ray tests).
 struct BoxRay {
-  v8f o[3], inv[3];
+  float o[3], inv[3];
   // Byte offsets in BvhNode of each axis's near and far planes (hi is the
   // near plane when d_a < 0, or -0).
   unsigned near_off[3], far_off[3];
-  v8f tmin;
+  float tmin;
   bool exact = true;  // false: float cannot hold this ray; visit every leaf
   // tmin >= 0 (every ray the tracer casts): then tnear >= 0, and tfar may
   // carry all the slack (Ize 2013's one-sided test, 2 operations fewer).
@@ -133,63 +137,62 @@ struct BoxRay {
   // The fused form (meet8_fma): oi = o * inv rounded to float, and
   // abs_slack = 3 E with E above its rounding error (see meet8_fma). Usable
   // when exact, nonneg, and every inv and oi finite (no d_a = 0).
-  v8f oi[3], abs_slack;
   bool fma_ok = false;
+  float oi[3], abs_slack;
 };
 
-// One vector division for the three 1/d_a: in float for float rays (the
-// correctly rounded 1/d), in double then rounded for double rays.
+// One float division for the three 1/d_a, of d rounded to float (for double
+// rays one rounding more than the correctly rounded 1/d: 2 of the 16 ulps
+// of kRelSlack; a double division is slower, on every ray's critical path).
 template <class T>
 [[gnu::always_inline]] inline BoxRay box_ray(const Vec3<T>& o, const Vec3<T>& d, T tmin) {
   typedef float v4 __attribute__((vector_size(16)));
-  typedef double v4d __attribute__((vector_size(32)));
   typedef int v4m __attribute__((vector_size(16)));
-  v4 inv;
-  if constexpr (sizeof(T) == sizeof(float)) {
-    inv = v4{1, 1, 1, 1} / v4{d.x, d.y, d.z, 1};
-  } else {
-    inv = __builtin_convertvector(v4d{1, 1, 1, 1} / v4d{d.x, d.y, d.z, 1}, v4);
-  }
+  const v4 df{float(d.x), float(d.y), float(d.z), 1};
+  const v4 inv = v4{1, 1, 1, 1} / df;
   const v4 of{float(o.x), float(o.y), float(o.z), 0};
-  const v4 dz{float(d.x == 0), float(d.y == 0), float(d.z == 0), 1};
-  const v4 abs_inv = (v4)((v4m)inv & 0x7FFFFFFF), abs_o = (v4)((v4m)of & 0x7FFFFFFF);
-  // Float must hold the origin, and 1/d_a must be a normal float unless d_a = 0.
-  const v4m ok = (abs_o <= 1e30f) & ((dz != 0) | ((abs_inv >= std::numeric_limits<float>::min()) &
-                                                   (abs_inv <= std::numeric_limits<float>::max())));
+  const v4m dz{-(d.x == 0), -(d.y == 0), -(d.z == 0), 0};
+  const v4 abs_d = (v4)((v4m)df & 0x7FFFFFFF), abs_inv = (v4)((v4m)inv & 0x7FFFFFFF),
+           abs_o = (v4)((v4m)of & 0x7FFFFFFF);
+  const v4 oi = of * inv, abs_oi = (v4)((v4m)oi & 0x7FFFFFFF);
+  // Float must hold the origin, and d_a and 1/d_a must be normal floats
+  // unless d_a = 0 (d_a's rounding to float must be relative).
+  constexpr float kMin = std::numeric_limits<float>::min();
+  const v4m normal = (abs_d >= kMin) & (abs_inv >= kMin) & (abs_inv <= std::numeric_limits<float>::max());
+  const v4m ok = (abs_o <= 1e30f) & (dz | normal);
+  const v4m fused = normal & (abs_oi <= std::numeric_limits<float>::max());
+  const int sign = _mm_movemask_ps((__m128)inv);
   BoxRay b;
   b.exact = _mm_movemask_ps((__m128)ok) == 0xF;
   for (int a = 0; a < 3; ++a) {
-    b.o[a] = splat(of[a]);
-    b.inv[a] = splat(inv[a]);
-    const bool near_hi = std::signbit(inv[a]);
+    b.o[a] = of[a];
+    b.inv[a] = inv[a];
+    b.oi[a] = oi[a];
+    const bool near_hi = (sign >> a) & 1;
     b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
     b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
   }
-  const float tmin_f = round_down(double(tmin));
-  b.tmin = splat(tmin_f);
-  b.nonneg = tmin_f >= 0;
-  const v4 oi = of * inv, abs_oi = (v4)((v4m)oi & 0x7FFFFFFF);
-  const v4m finite = (abs_inv <= std::numeric_limits<float>::max()) & (abs_oi <= std::numeric_limits<float>::max());
-  b.fma_ok = b.exact && b.nonneg && (_mm_movemask_ps((__m128)finite) & 7) == 7;
-  // E = 2^-22 (|oi_x| + |oi_y| + |oi_z|) + 2^-126 bounds each |o_a inv_a -
-  // oi_a| (at most half an ulp of oi_a, or 2^-150 where oi_a is subnormal)
-  // with room for this sum's own roundings.
-  const float e = (abs_oi[0] + abs_oi[1] + abs_oi[2]) * 0x1p-22f + 0x1p-126f;
-  for (int a = 0; a < 3; ++a) b.oi[a] = splat(oi[a]);
-  b.abs_slack = splat(3 * e);
+  b.tmin = round_down(double(tmin));
+  b.nonneg = b.tmin >= 0;
+  b.fma_ok = b.exact && b.nonneg && (_mm_movemask_ps((__m128)fused) & 7) == 7;
+  // E = 2^-22 max_a |oi_a| + 2^-126 bounds each |o_a inv_a - oi_a| (at most
+  // half an ulp of oi_a, 2^-24 |oi_a|, or 2^-150 where oi_a is subnormal).
+  const float m = std::max(std::max(abs_oi[0], abs_oi[1]), abs_oi[2]);
+  b.abs_slack = 3 * (m * 0x1p-22f + 0x1p-126f);
   return b;
 }
 
 // Bit i set: child i's box meets [tmin, tmax]; tnear gets each box's
 // lower bound of the entry t (for ordering and pruning).
 [[gnu::always_inline]] inline int meet8(const BvhNode& n, const BoxRay& r, float tmax, v8f& tnear) {
-  v8f tn = r.tmin, tf = splat(tmax);
+  v8f tn = splat(r.tmin), tf = splat(tmax);
   for (int a = 0; a < 3; ++a) {
     const char* base = reinterpret_cast<const char*>(&n);
     const v8f nearp = load8(reinterpret_cast<const float*>(base + r.near_off[a]));
     const v8f farp = load8(reinterpret_cast<const float*>(base + r.far_off[a]));
-    const v8f t0 = (nearp - r.o[a]) * r.inv[a];
-    const v8f t1 = (farp - r.o[a]) * r.inv[a];
+    const v8f o = splat(r.o[a]), inv = splat(r.inv[a]);
+    const v8f t0 = (nearp - o) * inv;
+    const v8f t1 = (farp - o) * inv;
     // NaN (origin exactly on the plane of a d_a = 0 slab) keeps the old bound.
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
@@ -245,16 +248,18 @@ template <class T>
   const char* base = reinterpret_cast<const char*>(&n);
   v8f t0[3], t1[3];
   for (int a = 0; a < 3; ++a) {
-    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), r.inv[a], r.oi[a]);
-    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), r.inv[a], r.oi[a]);
+    const v8f inv = splat(r.inv[a]), oi = splat(r.oi[a]);
+    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), inv, oi);
+    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), inv, oi);
   }
   // No NaN here: inv and oi are finite and nonzero-safe (empty children's
   // +-inf planes give +-inf).
-  const v8f n01 = t0[0] > t0[1] ? t0[0] : t0[1], n2 = t0[2] > r.tmin ? t0[2] : r.tmin;
+  const v8f tmin = splat(r.tmin);
+  const v8f n01 = t0[0] > t0[1] ? t0[0] : t0[1], n2 = t0[2] > tmin ? t0[2] : tmin;
   const v8f f01 = t1[0] < t1[1] ? t1[0] : t1[1], f2 = t1[2] < tmax ? t1[2] : tmax;
   const v8f tn = n01 > n2 ? n01 : n2, tf = f01 < f2 ? f01 : f2;
   tnear = tn;
-  return movemask_avx(tn <= fmadd(tf, splat(1 + 4 * Bvh::kRelSlack), r.abs_slack));
+  return movemask_avx(tn <= fmadd(tf, splat(1 + 4 * Bvh::kRelSlack), splat(r.abs_slack)));
 }
 
 #pragma GCC diagnostic pop
@@ -281,7 +286,7 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
   v8f tmax_v = splat(tmax_f);
   // What a box's tnear must exceed to be skipped (see meet8, meet8_fma).
   const float prune_scale = r.nonneg ? 1 + 4 * Bvh::kRelSlack : 1.f;
-  const float prune_add = kFused ? r.abs_slack[0] : 0.f;
+  const float prune_add = kFused ? r.abs_slack : 0.f;
   auto prune_of = [&](float t) __attribute__((always_inline)) {
     if constexpr (kFused) return __builtin_fmaf(t, prune_scale, prune_add);
     else return t * prune_scale;
