@@ -97,7 +97,8 @@ typedef int v8i __attribute__((vector_size(32)));
   __builtin_memcpy(&v, p, sizeof v);
   return v;
 }
-[[gnu::always_inline]] inline v8f splat(float x) { return v8f{} + x; }
+// A broadcast (v8f{} + x would add +0 to every lane: not foldable, -0 + 0 = +0).
+[[gnu::always_inline]] inline v8f splat(float x) { return v8f{x, x, x, x, x, x, x, x}; }
 [[gnu::always_inline]] inline v8f vabs(v8f x) { return (v8f)((v8i)x & 0x7FFFFFFF); }
 [[gnu::always_inline]] inline int movemask(v8i m) {
   __m128 lo, hi;
@@ -182,17 +183,38 @@ template <class T>
   return b;
 }
 
+// The box ray's values in 8 lanes, made once per ray by the traversal
+// (kept in registers or one load each through the loop).
+struct BoxRay8 {
+  v8f o[3], inv[3], oi[3], tmin, abs_slack;
+  unsigned near_off[3], far_off[3];
+  bool nonneg;
+};
+[[gnu::always_inline]] inline BoxRay8 widen(const BoxRay& r) {
+  BoxRay8 w;
+  for (int a = 0; a < 3; ++a) {
+    w.o[a] = splat(r.o[a]);
+    w.inv[a] = splat(r.inv[a]);
+    w.oi[a] = splat(r.oi[a]);
+    w.near_off[a] = r.near_off[a];
+    w.far_off[a] = r.far_off[a];
+  }
+  w.tmin = splat(r.tmin);
+  w.abs_slack = splat(r.abs_slack);
+  w.nonneg = r.nonneg;
+  return w;
+}
+
 // Bit i set: child i's box meets [tmin, tmax]; tnear gets each box's
 // lower bound of the entry t (for ordering and pruning).
-[[gnu::always_inline]] inline int meet8(const BvhNode& n, const BoxRay& r, float tmax, v8f& tnear) {
-  v8f tn = splat(r.tmin), tf = splat(tmax);
+[[gnu::always_inline]] inline int meet8(const BvhNode& n, const BoxRay8& r, float tmax, v8f& tnear) {
+  v8f tn = r.tmin, tf = splat(tmax);
   for (int a = 0; a < 3; ++a) {
     const char* base = reinterpret_cast<const char*>(&n);
     const v8f nearp = load8(reinterpret_cast<const float*>(base + r.near_off[a]));
     const v8f farp = load8(reinterpret_cast<const float*>(base + r.far_off[a]));
-    const v8f o = splat(r.o[a]), inv = splat(r.inv[a]);
-    const v8f t0 = (nearp - o) * inv;
-    const v8f t1 = (farp - o) * inv;
+    const v8f t0 = (nearp - r.o[a]) * r.inv[a];
+    const v8f t1 = (farp - r.o[a]) * r.inv[a];
     // NaN (origin exactly on the plane of a d_a = 0 slab) keeps the old bound.
     tn = t0 > tn ? t0 : tn;
     tf = t1 < tf ? t1 : tf;
@@ -244,22 +266,20 @@ template <class T>
 // tn' - E <= (tf' + E)(1 + s) / (1 - s): the test tn' <= tf' (1 + 4 s) + 3 E
 // (fused, so rounded once, down by at most 2^-24 relative, inside the 4 s)
 // never rejects it. tnear = tn' for pruning against tmax (1 + 4 s) + 3 E.
-[[gnu::always_inline]] inline int meet8_fma(const BvhNode& n, const BoxRay& r, v8f tmax, v8f& tnear) {
+[[gnu::always_inline]] inline int meet8_fma(const BvhNode& n, const BoxRay8& r, v8f tmax, v8f& tnear) {
   const char* base = reinterpret_cast<const char*>(&n);
   v8f t0[3], t1[3];
   for (int a = 0; a < 3; ++a) {
-    const v8f inv = splat(r.inv[a]), oi = splat(r.oi[a]);
-    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), inv, oi);
-    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), inv, oi);
+    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), r.inv[a], r.oi[a]);
+    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), r.inv[a], r.oi[a]);
   }
   // No NaN here: inv and oi are finite and nonzero-safe (empty children's
   // +-inf planes give +-inf).
-  const v8f tmin = splat(r.tmin);
-  const v8f n01 = t0[0] > t0[1] ? t0[0] : t0[1], n2 = t0[2] > tmin ? t0[2] : tmin;
+  const v8f n01 = t0[0] > t0[1] ? t0[0] : t0[1], n2 = t0[2] > r.tmin ? t0[2] : r.tmin;
   const v8f f01 = t1[0] < t1[1] ? t1[0] : t1[1], f2 = t1[2] < tmax ? t1[2] : tmax;
   const v8f tn = n01 > n2 ? n01 : n2, tf = f01 < f2 ? f01 : f2;
   tnear = tn;
-  return movemask_avx(tn <= fmadd(tf, splat(1 + 4 * Bvh::kRelSlack), splat(r.abs_slack)));
+  return movemask_avx(tn <= fmadd(tf, splat(1 + 4 * Bvh::kRelSlack), r.abs_slack));
 }
 
 #pragma GCC diagnostic pop
@@ -292,6 +312,7 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
     else return t * prune_scale;
   };
   float prune = prune_of(tmax_f);
+  const BoxRay8 r8 = widen(r);
   std::uint32_t cur = 0;  // the root is a node (a lone leaf gets one)
   for (;;) {
     if (Bvh::is_leaf(cur)) {
@@ -308,9 +329,9 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
       {
         v8f tnv;
         if constexpr (kFused) {
-          mask = meet8_fma(n, r, tmax_v, tnv);
+          mask = meet8_fma(n, r8, tmax_v, tnv);
         } else if (r.exact) {
-          mask = meet8(n, r, tmax_f, tnv);
+          mask = meet8(n, r8, tmax_f, tnv);
         } else {
           mask = 0;
           for (int i = 0; i < 8; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
