@@ -250,6 +250,15 @@ struct BoxRay8 {
   asm("vfmadd213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
   return a;
 }
+// Lane i of v, without a trip through memory (storing v and loading a
+// lane stalls: the 4-byte load cannot take its bytes from the 32-byte store
+// in flight).
+[[gnu::always_inline]] inline float lane_avx(v8f v, int i) {
+  const v8i idx{i, i, i, i, i, i, i, i};
+  v8f r;
+  asm("vpermps %1, %2, %0" : "=x"(r) : "x"(v), "x"(idx));
+  return r[0];
+}
 [[gnu::always_inline]] inline int movemask_avx(v8i m) {
   int r;
   asm("vmovmskps %1, %0" : "=r"(r) : "x"(m));
@@ -324,10 +333,10 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
       }
     } else {
       const BvhNode& n = bvh.nodes[cur];
-      alignas(32) float tn[8];
+      alignas(32) float tn_mem[8];
       int mask;
+      v8f tnv;
       {
-        v8f tnv;
         if constexpr (kFused) {
           mask = meet8_fma(n, r8, tmax_v, tnv);
         } else if (r.exact) {
@@ -337,8 +346,13 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
           for (int i = 0; i < 8; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
           tnv = splat(-INFINITY);
         }
-        if constexpr (kClosest) __builtin_memcpy(tn, &tnv, sizeof tn);
+        if constexpr (kClosest && !kFused) __builtin_memcpy(tn_mem, &tnv, sizeof tn_mem);
       }
+      // Child k's tnear (closest hit only).
+      auto tn = [&](int k) __attribute__((always_inline)) {
+        if constexpr (kFused) return lane_avx(tnv, k);
+        else return tn_mem[k];
+      };
       if (mask) {
 #ifndef RA_BVH_NO_PREFETCH
         // Ask for every child met now: its node's lines, or its leaf's data
@@ -371,18 +385,18 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
           const int j = __builtin_ctz(unsigned(mask));
           mask &= mask - 1;
           if (!mask) {  // two children (the usual case): the nearer first
-            const bool swap = tn[j] < tn[i];
+            const bool swap = tn(j) < tn(i);
             const int nearer = swap ? j : i, farther = swap ? i : j;
-            stack[top++] = {n.child[farther], tn[farther]};
+            stack[top++] = {n.child[farther], tn(farther)};
             cur = n.child[nearer];
             continue;
           }
           // More: push all sorted so the nearest is on top, then take it.
           const int base = top;
-          stack[top++] = {n.child[i], tn[i]};
+          stack[top++] = {n.child[i], tn(i)};
           for (mask |= 1 << j; mask; mask &= mask - 1) {
             const int k0 = __builtin_ctz(unsigned(mask));
-            const Entry c{n.child[k0], tn[k0]};
+            const Entry c{n.child[k0], tn(k0)};
             int k = top++;
             while (k > base && stack[k - 1].tnear < c.tnear) {
               stack[k] = stack[k - 1];
