@@ -125,8 +125,9 @@ inline float round_up(double x) {
 // The ray as the box test sees it: scalars, broadcast where used (a
 // broadcast from memory costs a load; eleven 8-lane copies per ray cost
 // more than the boxes a missing ray tests).
+typedef float v4f __attribute__((vector_size(16)));
 struct BoxRay {
-  float o[3], inv[3];
+  v4f o, inv;  // lanes x, y, z (and 0, 1)
   // Byte offsets in BvhNode of each axis's near and far planes (hi is the
   // near plane when d_a < 0, or -0).
   unsigned near_off[3], far_off[3];
@@ -139,7 +140,8 @@ struct BoxRay {
   // abs_slack = 3 E with E above its rounding error (see meet8_fma). Usable
   // when exact, nonneg, and every inv and oi finite (no d_a = 0).
   bool fma_ok = false;
-  float oi[3], abs_slack;
+  v4f oi;
+  float abs_slack;
 };
 
 // One float division for the three 1/d_a, of d rounded to float (for double
@@ -164,11 +166,11 @@ template <class T>
   const v4m fused = normal & (abs_oi <= std::numeric_limits<float>::max());
   const int sign = _mm_movemask_ps((__m128)inv);
   BoxRay b;
+  b.o = of;
+  b.inv = inv;
+  b.oi = oi;
   b.exact = _mm_movemask_ps((__m128)ok) == 0xF;
   for (int a = 0; a < 3; ++a) {
-    b.o[a] = of[a];
-    b.inv[a] = inv[a];
-    b.oi[a] = oi[a];
     const bool near_hi = (sign >> a) & 1;
     b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
     b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
@@ -192,10 +194,17 @@ struct BoxRay8 {
 };
 [[gnu::always_inline]] inline BoxRay8 widen(const BoxRay& r) {
   BoxRay8 w;
+  // Lane a to all 8 lanes: one shuffle (vbroadcastss / vpermps) each.
+  w.o[0] = __builtin_shufflevector(r.o, r.o, 0, 0, 0, 0, 0, 0, 0, 0);
+  w.o[1] = __builtin_shufflevector(r.o, r.o, 1, 1, 1, 1, 1, 1, 1, 1);
+  w.o[2] = __builtin_shufflevector(r.o, r.o, 2, 2, 2, 2, 2, 2, 2, 2);
+  w.inv[0] = __builtin_shufflevector(r.inv, r.inv, 0, 0, 0, 0, 0, 0, 0, 0);
+  w.inv[1] = __builtin_shufflevector(r.inv, r.inv, 1, 1, 1, 1, 1, 1, 1, 1);
+  w.inv[2] = __builtin_shufflevector(r.inv, r.inv, 2, 2, 2, 2, 2, 2, 2, 2);
+  w.oi[0] = __builtin_shufflevector(r.oi, r.oi, 0, 0, 0, 0, 0, 0, 0, 0);
+  w.oi[1] = __builtin_shufflevector(r.oi, r.oi, 1, 1, 1, 1, 1, 1, 1, 1);
+  w.oi[2] = __builtin_shufflevector(r.oi, r.oi, 2, 2, 2, 2, 2, 2, 2, 2);
   for (int a = 0; a < 3; ++a) {
-    w.o[a] = splat(r.o[a]);
-    w.inv[a] = splat(r.inv[a]);
-    w.oi[a] = splat(r.oi[a]);
     w.near_off[a] = r.near_off[a];
     w.far_off[a] = r.far_off[a];
   }
