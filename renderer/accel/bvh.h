@@ -363,12 +363,10 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
         else return tn_mem[k];
       };
       if (mask) {
-#ifndef RA_BVH_NO_PREFETCH
         // Ask for every child met now: its node's lines, or its leaf's data
         // (Embree does the same); the loads overlap instead of following
         // one another down the tree.
-        for (int m = mask; m; m &= m - 1) {
-          const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
+        auto prefetch = [&](std::uint32_t c) __attribute__((always_inline)) {
           if (Bvh::is_leaf(c)) {
             leaf_prefetch(Bvh::leaf_first(c));
           } else {
@@ -378,19 +376,26 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
             __builtin_prefetch(p + 128);
             __builtin_prefetch(p + 192);
           }
-        }
-#endif
-        const int i = __builtin_ctz(unsigned(mask));
-        mask &= mask - 1;
-        if (!mask) {  // one child: straight to it
-          cur = n.child[i];
-          continue;
-        }
+        };
         if constexpr (!kClosest) {
-          cur = n.child[i];
-          for (; mask; mask &= mask - 1) stack[top++] = n.child[__builtin_ctz(unsigned(mask))];
+          // Any hit, in any order: every child met asked for and pushed in
+          // one pass, the last one taken back (one loop, fewer branches to
+          // mispredict than a separate one-child case).
+          for (int m = mask; m; m &= m - 1) {
+            const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
+            prefetch(c);
+            stack[top++] = c;
+          }
+          cur = stack[--top];
           continue;
         } else {
+          for (int m = mask; m; m &= m - 1) prefetch(n.child[__builtin_ctz(unsigned(m))]);
+          const int i = __builtin_ctz(unsigned(mask));
+          mask &= mask - 1;
+          if (!mask) {  // one child: straight to it
+            cur = n.child[i];
+            continue;
+          }
           const int j = __builtin_ctz(unsigned(mask));
           mask &= mask - 1;
           if (!mask) {  // two children (the usual case): the nearer first
