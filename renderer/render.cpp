@@ -68,6 +68,13 @@ struct PreparedMesh {
 // Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
 // object, then the lower triangle, so the answer does not depend on the order
 // an acceleration structure visits them in.
+// Asks for a leaf block's cache lines ahead of its test.
+template <class B>
+[[gnu::always_inline]] inline void prefetch_block(const B& b) {
+  const char* p = reinterpret_cast<const char*>(&b);
+  for (std::size_t k = 0; k < sizeof(B); k += 64) __builtin_prefetch(p + k);
+}
+
 bool nearer(double t, int object, int prim, const SceneHit& best) {
   if (t != best.t) return t < best.t;
   if (object != best.object) return object < best.object;
@@ -101,7 +108,7 @@ struct Tracer::Impl {
       throw InputError("unknown sphere method \"" + o.sphere_method +
                        "\"; valid: " + method_names(Kind::sphere));
     pln_method = &default_method(Kind::plane);
-    avx2 = o.simd && __builtin_cpu_supports("avx2");
+    avx2 = o.simd && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
     if (o.samples_per_axis < 1 || o.samples_per_axis > 16)
       throw InputError("samples per axis must be between 1 and 16");
     mesh_index.assign(s.objects.size(), -1);
@@ -209,8 +216,9 @@ struct Tracer::Impl {
 
   // Closest hit at precision T. The ray arrives in double (shading is done in
   // double); the kernels see it converted to T. Inlined into closest() and
-  // closest_avx2(), which compile it for baseline x86-64 and for AVX2.
-  template <class T>
+  // closest_avx2(), which compile it for baseline x86-64 and for AVX2 and
+  // FMA (kFma: the BVH's fused box test).
+  template <class T, bool kFma>
   [[gnu::always_inline]] inline std::optional<SceneHit> closest_impl(const Ray<double>& rd, int only = -1) const {
     const Ray<T> r(rd);
     SceneHit best;
@@ -246,7 +254,7 @@ struct Tracer::Impl {
           }
           if (opt.accel == Accel::bvh) {
             if (!m.tri4.empty()) {
-              traverse<true>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+              traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
                 moller_simd::Hit4<T> h;
                 moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
                 for (int hits = h.hits; hits; hits &= hits - 1) {
@@ -254,10 +262,10 @@ struct Tracer::Impl {
                   consider(double(h.t[l]), int(oi), int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
                 }
                 return false;
-              });
+              }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
               break;
             }
-            traverse<true>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+            traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
               for (std::uint32_t slot = first; slot < first + count; ++slot)
                 if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
                   consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
@@ -343,7 +351,7 @@ struct Tracer::Impl {
   }
 
   // Is anything in the ray's window? (shadow rays) Inlined as closest_impl.
-  template <class T>
+  template <class T, bool kFma>
   [[gnu::always_inline]] inline bool occluded_impl(const Ray<T>& r) const {
     for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
       const Object& o = scene.objects[oi];
@@ -365,13 +373,13 @@ struct Tracer::Impl {
           if (opt.accel == Accel::bvh) {
             bool hit = false;
             if (!m.tri4.empty()) {
-              traverse<false>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+              traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
                 moller_simd::Hit4<T> h;
                 moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
                 return hit = h.hits != 0;
-              });
+              }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
             } else {
-              traverse<false>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+              traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                 for (std::uint32_t slot = first; slot < first + count; ++slot)
                   if (k.any_pre(r, m.pre.data() + slot * m.stride, m.cull)) return hit = true;
                 return false;
@@ -394,26 +402,27 @@ struct Tracer::Impl {
   }
 
   // The SIMD paths chosen at run time: the BVH's 8-wide box tests and the
-  // double leaves are one AVX register each where the CPU has AVX2, two SSE
-  // registers otherwise; the answers are the same bits either way.
+  // double leaves are one AVX register each where the CPU has AVX2 (and
+  // FMA, for the fused box test), two SSE registers otherwise; the answers
+  // are the same bits either way.
   bool avx2 = false;
 
   // `only` >= 0 restricts the search to that one object (POV-Ray's shadow
   // cache asks about the object that shadowed the previous pixel).
   template <class T>
-  std::optional<SceneHit> closest_base(const Ray<double>& rd, int only) const { return closest_impl<T>(rd, only); }
+  std::optional<SceneHit> closest_base(const Ray<double>& rd, int only) const { return closest_impl<T, false>(rd, only); }
   template <class T>
-  [[gnu::target("avx2")]] std::optional<SceneHit> closest_avx2(const Ray<double>& rd, int only) const {
-    return closest_impl<T>(rd, only);
+  [[gnu::target("avx2,fma")]] std::optional<SceneHit> closest_avx2(const Ray<double>& rd, int only) const {
+    return closest_impl<T, true>(rd, only);
   }
   template <class T>
   std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1) const {
     return avx2 ? closest_avx2<T>(rd, only) : closest_base<T>(rd, only);
   }
   template <class T>
-  bool occluded_base(const Ray<T>& r) const { return occluded_impl<T>(r); }
+  bool occluded_base(const Ray<T>& r) const { return occluded_impl<T, false>(r); }
   template <class T>
-  [[gnu::target("avx2")]] bool occluded_avx2(const Ray<T>& r) const { return occluded_impl<T>(r); }
+  [[gnu::target("avx2,fma")]] bool occluded_avx2(const Ray<T>& r) const { return occluded_impl<T, true>(r); }
   template <class T>
   bool occluded(const Ray<T>& r) const { return avx2 ? occluded_avx2<T>(r) : occluded_base<T>(r); }
 

@@ -20,22 +20,25 @@
 //    <= 2^-24 * 2 size, far below the padding; farther out every box plane
 //    is at least |o_a| / 2 away, so the error is at most 2^-23 relative to
 //    (plane - o_a), i.e. relative in t;
-//  - 1/d rounded to float (from double for double rays), the subtraction
-//    and the product add 3 roundings:
+//  - d rounded to float (double rays), 1/d in float, the subtraction and
+//    the product add 4 roundings (the fused test of meet8_fma: 3, plus an
+//    absolute term bounded per ray):
 //    all of it is relative to t, covered by widening [tnear, tfar] by
 //    kRelSlack = 2^-20 (16 float ulps) of their magnitudes;
 //  - d_a = 0 gives 1/d_a = +-inf: (plane - o_a) * inf is +-inf, or NaN when
 //    o_a lies exactly on the plane, which the min/max below ignore (the slab
 //    then constrains nothing), as Williams et al. 2005 intend;
-//  - a ray float cannot hold (|o| > 1e30, |1/d| below float's normal range
-//    or above it while d != 0) visits every leaf instead.
+//  - a ray float cannot hold (|o| > 1e30, |d| or |1/d| outside float's
+//    normal range while d != 0) visits every leaf instead.
 #pragma once
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "../vec.h"
@@ -94,7 +97,8 @@ typedef int v8i __attribute__((vector_size(32)));
   __builtin_memcpy(&v, p, sizeof v);
   return v;
 }
-[[gnu::always_inline]] inline v8f splat(float x) { return v8f{} + x; }
+// A broadcast (v8f{} + x would add +0 to every lane: not foldable, -0 + 0 = +0).
+[[gnu::always_inline]] inline v8f splat(float x) { return v8f{x, x, x, x, x, x, x, x}; }
 [[gnu::always_inline]] inline v8f vabs(v8f x) { return (v8f)((v8i)x & 0x7FFFFFFF); }
 [[gnu::always_inline]] inline int movemask(v8i m) {
   __m128 lo, hi;
@@ -118,56 +122,101 @@ inline float round_up(double x) {
   return f > 1e-30f ? f * (1 + 0x1p-23f) : f < -1e-30f ? f * (1 - 0x1p-23f) : f + 1e-30f;
 }
 
-// The ray as the box test sees it.
+// The ray as the box test sees it: scalars, broadcast where used (a
+// broadcast from memory costs a load; eleven 8-lane copies per ray cost
+// more than the boxes a missing ray tests).
+typedef float v4f __attribute__((vector_size(16)));
 struct BoxRay {
-  v8f o[3], inv[3];
+  v4f o, inv;  // lanes x, y, z (and 0, 1)
   // Byte offsets in BvhNode of each axis's near and far planes (hi is the
   // near plane when d_a < 0, or -0).
   unsigned near_off[3], far_off[3];
-  v8f tmin;
+  float tmin;
   bool exact = true;  // false: float cannot hold this ray; visit every leaf
   // tmin >= 0 (every ray the tracer casts): then tnear >= 0, and tfar may
   // carry all the slack (Ize 2013's one-sided test, 2 operations fewer).
   bool nonneg = false;
+  // The fused form (meet8_fma): oi = o * inv rounded to float, and
+  // abs_slack = 3 E with E above its rounding error (see meet8_fma). Usable
+  // when exact, nonneg, and every inv and oi finite (no d_a = 0).
+  bool fma_ok = false;
+  v4f oi;
+  float abs_slack;
 };
 
-// One vector division for the three 1/d_a: in float for float rays (the
-// correctly rounded 1/d), in double then rounded for double rays.
+// One float division for the three 1/d_a, of d rounded to float (for double
+// rays one rounding more than the correctly rounded 1/d: 2 of the 16 ulps
+// of kRelSlack; a double division is slower, on every ray's critical path).
 template <class T>
 [[gnu::always_inline]] inline BoxRay box_ray(const Vec3<T>& o, const Vec3<T>& d, T tmin) {
   typedef float v4 __attribute__((vector_size(16)));
-  typedef double v4d __attribute__((vector_size(32)));
   typedef int v4m __attribute__((vector_size(16)));
-  v4 inv;
-  if constexpr (sizeof(T) == sizeof(float)) {
-    inv = v4{1, 1, 1, 1} / v4{d.x, d.y, d.z, 1};
-  } else {
-    inv = __builtin_convertvector(v4d{1, 1, 1, 1} / v4d{d.x, d.y, d.z, 1}, v4);
-  }
+  const v4 df{float(d.x), float(d.y), float(d.z), 1};
+  const v4 inv = v4{1, 1, 1, 1} / df;
   const v4 of{float(o.x), float(o.y), float(o.z), 0};
-  const v4 dz{float(d.x == 0), float(d.y == 0), float(d.z == 0), 1};
-  const v4 abs_inv = (v4)((v4m)inv & 0x7FFFFFFF), abs_o = (v4)((v4m)of & 0x7FFFFFFF);
-  // Float must hold the origin, and 1/d_a must be a normal float unless d_a = 0.
-  const v4m ok = (abs_o <= 1e30f) & ((dz != 0) | ((abs_inv >= std::numeric_limits<float>::min()) &
-                                                   (abs_inv <= std::numeric_limits<float>::max())));
+  const v4m dz{-(d.x == 0), -(d.y == 0), -(d.z == 0), 0};
+  const v4 abs_d = (v4)((v4m)df & 0x7FFFFFFF), abs_inv = (v4)((v4m)inv & 0x7FFFFFFF),
+           abs_o = (v4)((v4m)of & 0x7FFFFFFF);
+  const v4 oi = of * inv, abs_oi = (v4)((v4m)oi & 0x7FFFFFFF);
+  // Float must hold the origin, and d_a and 1/d_a must be normal floats
+  // unless d_a = 0 (d_a's rounding to float must be relative).
+  constexpr float kMin = std::numeric_limits<float>::min();
+  const v4m normal = (abs_d >= kMin) & (abs_inv >= kMin) & (abs_inv <= std::numeric_limits<float>::max());
+  const v4m ok = (abs_o <= 1e30f) & (dz | normal);
+  const v4m fused = normal & (abs_oi <= std::numeric_limits<float>::max());
+  const int sign = _mm_movemask_ps((__m128)inv);
   BoxRay b;
+  b.o = of;
+  b.inv = inv;
+  b.oi = oi;
   b.exact = _mm_movemask_ps((__m128)ok) == 0xF;
   for (int a = 0; a < 3; ++a) {
-    b.o[a] = splat(of[a]);
-    b.inv[a] = splat(inv[a]);
-    const bool near_hi = std::signbit(inv[a]);
+    const bool near_hi = (sign >> a) & 1;
     b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
     b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
   }
-  const float tmin_f = round_down(double(tmin));
-  b.tmin = splat(tmin_f);
-  b.nonneg = tmin_f >= 0;
+  b.tmin = round_down(double(tmin));
+  b.nonneg = b.tmin >= 0;
+  b.fma_ok = b.exact && b.nonneg && (_mm_movemask_ps((__m128)fused) & 7) == 7;
+  // E = 2^-22 max_a |oi_a| + 2^-126 bounds each |o_a inv_a - oi_a| (at most
+  // half an ulp of oi_a, 2^-24 |oi_a|, or 2^-150 where oi_a is subnormal).
+  const float m = std::max(std::max(abs_oi[0], abs_oi[1]), abs_oi[2]);
+  b.abs_slack = 3 * (m * 0x1p-22f + 0x1p-126f);
   return b;
+}
+
+// The box ray's values in 8 lanes, made once per ray by the traversal
+// (kept in registers or one load each through the loop).
+struct BoxRay8 {
+  v8f o[3], inv[3], oi[3], tmin, abs_slack;
+  unsigned near_off[3], far_off[3];
+  bool nonneg;
+};
+[[gnu::always_inline]] inline BoxRay8 widen(const BoxRay& r) {
+  BoxRay8 w;
+  // Lane a to all 8 lanes: one shuffle (vbroadcastss / vpermps) each.
+  w.o[0] = __builtin_shufflevector(r.o, r.o, 0, 0, 0, 0, 0, 0, 0, 0);
+  w.o[1] = __builtin_shufflevector(r.o, r.o, 1, 1, 1, 1, 1, 1, 1, 1);
+  w.o[2] = __builtin_shufflevector(r.o, r.o, 2, 2, 2, 2, 2, 2, 2, 2);
+  w.inv[0] = __builtin_shufflevector(r.inv, r.inv, 0, 0, 0, 0, 0, 0, 0, 0);
+  w.inv[1] = __builtin_shufflevector(r.inv, r.inv, 1, 1, 1, 1, 1, 1, 1, 1);
+  w.inv[2] = __builtin_shufflevector(r.inv, r.inv, 2, 2, 2, 2, 2, 2, 2, 2);
+  w.oi[0] = __builtin_shufflevector(r.oi, r.oi, 0, 0, 0, 0, 0, 0, 0, 0);
+  w.oi[1] = __builtin_shufflevector(r.oi, r.oi, 1, 1, 1, 1, 1, 1, 1, 1);
+  w.oi[2] = __builtin_shufflevector(r.oi, r.oi, 2, 2, 2, 2, 2, 2, 2, 2);
+  for (int a = 0; a < 3; ++a) {
+    w.near_off[a] = r.near_off[a];
+    w.far_off[a] = r.far_off[a];
+  }
+  w.tmin = splat(r.tmin);
+  w.abs_slack = splat(r.abs_slack);
+  w.nonneg = r.nonneg;
+  return w;
 }
 
 // Bit i set: child i's box meets [tmin, tmax]; tnear gets each box's
 // lower bound of the entry t (for ordering and pruning).
-[[gnu::always_inline]] inline int meet8(const BvhNode& n, const BoxRay& r, float tmax, v8f& tnear) {
+[[gnu::always_inline]] inline int meet8(const BvhNode& n, const BoxRay8& r, float tmax, v8f& tnear) {
   v8f tn = r.tmin, tf = splat(tmax);
   for (int a = 0; a < 3; ++a) {
     const char* base = reinterpret_cast<const char*>(&n);
@@ -197,77 +246,171 @@ template <class T>
   return movemask(tnear <= far_up);
 }
 
+// a * b - c and a * b + c rounded once, and the sign bits of 8 lanes: one
+// AVX2/FMA instruction each. Written as assembly because the traversal is
+// generic code inlined into the tracer's AVX2+FMA entry points (GCC does
+// not inline target-specific intrinsics into it); only those entry points
+// instantiate them (traverse's kFma).
+[[gnu::always_inline]] inline v8f fmsub(v8f a, v8f b, v8f c) {
+  asm("vfmsub213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
+  return a;
+}
+[[gnu::always_inline]] inline v8f fmadd(v8f a, v8f b, v8f c) {
+  asm("vfmadd213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
+  return a;
+}
+// Lane i of v, without a trip through memory (storing v and loading a
+// lane stalls: the 4-byte load cannot take its bytes from the 32-byte store
+// in flight).
+[[gnu::always_inline]] inline float lane_avx(v8f v, int i) {
+  const v8i idx{i, i, i, i, i, i, i, i};
+  v8f r;
+  asm("vpermps %1, %2, %0" : "=x"(r) : "x"(v), "x"(idx));
+  return r[0];
+}
+[[gnu::always_inline]] inline int movemask_avx(v8i m) {
+  int r;
+  asm("vmovmskps %1, %0" : "=r"(r) : "x"(m));
+  return r;
+}
+
+// meet8 with one fused multiply-subtract per plane, t = p inv - oi, for
+// rays with fma_ok (Embree's form; here made conservative). Against
+// meet8's fl(fl(p - o) inv) it rounds once where meet8 rounds twice, and
+// adds the absolute error d_a = o_a inv_a - oi_a (|d_a| <= E / 4):
+// t' = ((p - o) inv + d_a)(1 + e), |e| <= 2^-24. With s the relative slack
+// of meet8 and tmin >= 0, every axis's entry t' <= tnear (1 + s) + E and
+// exit t' >= tfar (1 - s) - E, so a box the exact segment meets has
+// tn' - E <= (tf' + E)(1 + s) / (1 - s): the test tn' <= tf' (1 + 4 s) + 3 E
+// (fused, so rounded once, down by at most 2^-24 relative, inside the 4 s)
+// never rejects it. tnear = tn' for pruning against tmax (1 + 4 s) + 3 E.
+[[gnu::always_inline]] inline int meet8_fma(const BvhNode& n, const BoxRay8& r, v8f tmax, v8f& tnear) {
+  const char* base = reinterpret_cast<const char*>(&n);
+  v8f t0[3], t1[3];
+  for (int a = 0; a < 3; ++a) {
+    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), r.inv[a], r.oi[a]);
+    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), r.inv[a], r.oi[a]);
+  }
+  // No NaN here: inv and oi are finite and nonzero-safe (empty children's
+  // +-inf planes give +-inf).
+  const v8f n01 = t0[0] > t0[1] ? t0[0] : t0[1], n2 = t0[2] > r.tmin ? t0[2] : r.tmin;
+  const v8f f01 = t1[0] < t1[1] ? t1[0] : t1[1], f2 = t1[2] < tmax ? t1[2] : tmax;
+  const v8f tn = n01 > n2 ? n01 : n2, tf = f01 < f2 ? f01 : f2;
+  tnear = tn;
+  return movemask_avx(tn <= fmadd(tf, splat(1 + 4 * Bvh::kRelSlack), r.abs_slack));
+}
+
 #pragma GCC diagnostic pop
 
 }  // namespace bvh_detail
 
-// Visits the leaves whose boxes the ray's window meets; `leaf(first_slot,
-// count)` returns true to stop. kClosest: nearest box first, `tmax` re-read
-// after every leaf (closest-hit shrinks it) and boxes entered beyond it
-// skipped; otherwise (any hit) in node order, without sorting. The nearest
-// child hit is visited next without going through the stack.
-// Always inlined, so that it is compiled for the ISA of its caller.
-template <bool kClosest, class T, class Leaf>
-[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
-                                            Leaf&& leaf) {
-  using namespace bvh_detail;
-  if (bvh.nodes.empty()) return;
-  const BoxRay r = box_ray(o, d, tmin);
+namespace bvh_detail {
+
+// traverse's loop for one box test: kFused, meet8_fma (the ray has
+// fma_ok); otherwise meet8, or every child where float cannot hold the ray.
+template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
+[[gnu::always_inline]] inline void traverse_loop(const Bvh& bvh, const BoxRay& r, const T& tmax, Leaf&& leaf,
+                                                 LeafPrefetch&& leaf_prefetch) {
+  // Closest hit keeps each pushed box's tnear to skip it later; any hit
+  // needs only the node.
   struct Entry {
     std::uint32_t node;
     float tnear;
   };
-  Entry stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
+  using Slot = std::conditional_t<kClosest, Entry, std::uint32_t>;
+  Slot stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
   int top = 0;
   float tmax_f = round_up(double(tmax));
-  // What a box's tnear must exceed to be skipped (see meet8).
+  v8f tmax_v = splat(tmax_f);
+  // What a box's tnear must exceed to be skipped (see meet8, meet8_fma).
   const float prune_scale = r.nonneg ? 1 + 4 * Bvh::kRelSlack : 1.f;
-  float prune = tmax_f * prune_scale;
+  const float prune_add = kFused ? r.abs_slack : 0.f;
+  auto prune_of = [&](float t) __attribute__((always_inline)) {
+    if constexpr (kFused) return __builtin_fmaf(t, prune_scale, prune_add);
+    else return t * prune_scale;
+  };
+  float prune = prune_of(tmax_f);
+  const BoxRay8 r8 = widen(r);
   std::uint32_t cur = 0;  // the root is a node (a lone leaf gets one)
   for (;;) {
     if (Bvh::is_leaf(cur)) {
       if (leaf(Bvh::leaf_first(cur), Bvh::leaf_count(cur))) return;
       if constexpr (kClosest) {
         tmax_f = round_up(double(tmax));
-        prune = tmax_f * prune_scale;
+        tmax_v = splat(tmax_f);
+        prune = prune_of(tmax_f);
       }
     } else {
       const BvhNode& n = bvh.nodes[cur];
-      alignas(32) float tn[8];
+      alignas(32) float tn_mem[8];
       int mask;
-      if (r.exact) {
-        v8f tnv;
-        mask = meet8(n, r, tmax_f, tnv);
-        __builtin_memcpy(tn, &tnv, sizeof tn);
-      } else {
-        mask = 0;
-        for (int i = 0; i < 8; ++i) {
-          mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
-          tn[i] = -INFINITY;
+      v8f tnv;
+      {
+        if constexpr (kFused) {
+          mask = meet8_fma(n, r8, tmax_v, tnv);
+        } else if (r.exact) {
+          mask = meet8(n, r8, tmax_f, tnv);
+        } else {
+          mask = 0;
+          for (int i = 0; i < 8; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
+          tnv = splat(-INFINITY);
         }
+        if constexpr (kClosest && !kFused) __builtin_memcpy(tn_mem, &tnv, sizeof tn_mem);
       }
+      // Child k's tnear (closest hit only).
+      auto tn = [&](int k) __attribute__((always_inline)) {
+        if constexpr (kFused) return lane_avx(tnv, k);
+        else return tn_mem[k];
+      };
       if (mask) {
-        int i = __builtin_ctz(unsigned(mask));
-        mask &= mask - 1;
-        if (!mask) {  // one child: straight to it
-          cur = n.child[i];
-          continue;
-        }
-        if constexpr (!kClosest) {
-          cur = n.child[i];
-          for (; mask; mask &= mask - 1) {
-            const int j = __builtin_ctz(unsigned(mask));
-            stack[top++] = {n.child[j], tn[j]};
+        // Ask for every child met now: its node's lines, or its leaf's data
+        // (Embree does the same); the loads overlap instead of following
+        // one another down the tree.
+        auto prefetch = [&](std::uint32_t c) __attribute__((always_inline)) {
+          if (Bvh::is_leaf(c)) {
+            leaf_prefetch(Bvh::leaf_first(c));
+          } else {
+            const char* p = reinterpret_cast<const char*>(&bvh.nodes[c]);
+            __builtin_prefetch(p);
+            __builtin_prefetch(p + 64);
+            __builtin_prefetch(p + 128);
+            __builtin_prefetch(p + 192);
           }
+        };
+        if constexpr (!kClosest) {
+          // Any hit, in any order: every child met asked for and pushed in
+          // one pass, the last one taken back (one loop, fewer branches to
+          // mispredict than a separate one-child case).
+          for (int m = mask; m; m &= m - 1) {
+            const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
+            prefetch(c);
+            stack[top++] = c;
+          }
+          cur = stack[--top];
           continue;
         } else {
-          // Push all hit children sorted so the nearest is on top, then
-          // take it.
+          for (int m = mask; m; m &= m - 1) prefetch(n.child[__builtin_ctz(unsigned(m))]);
+          const int i = __builtin_ctz(unsigned(mask));
+          mask &= mask - 1;
+          if (!mask) {  // one child: straight to it
+            cur = n.child[i];
+            continue;
+          }
+          const int j = __builtin_ctz(unsigned(mask));
+          mask &= mask - 1;
+          if (!mask) {  // two children (the usual case): the nearer first
+            const bool swap = tn(j) < tn(i);
+            const int nearer = swap ? j : i, farther = swap ? i : j;
+            stack[top++] = {n.child[farther], tn(farther)};
+            cur = n.child[nearer];
+            continue;
+          }
+          // More: push all sorted so the nearest is on top, then take it.
           const int base = top;
-          stack[top++] = {n.child[i], tn[i]};
-          for (; mask; mask &= mask - 1) {
-            const int j = __builtin_ctz(unsigned(mask));
-            const Entry c{n.child[j], tn[j]};
+          stack[top++] = {n.child[i], tn(i)};
+          for (mask |= 1 << j; mask; mask &= mask - 1) {
+            const int k0 = __builtin_ctz(unsigned(mask));
+            const Entry c{n.child[k0], tn(k0)};
             int k = top++;
             while (k > base && stack[k - 1].tnear < c.tnear) {
               stack[k] = stack[k - 1];
@@ -281,14 +424,47 @@ template <bool kClosest, class T, class Leaf>
       }
     }
     // Next from the stack, skipping boxes entered beyond the closest hit.
-    for (;;) {
+    if constexpr (kClosest) {
+      for (;;) {
+        if (top == 0) return;
+        const Entry e = stack[--top];
+        if (e.tnear > prune) continue;
+        cur = e.node;
+        break;
+      }
+    } else {
       if (top == 0) return;
-      const Entry e = stack[--top];
-      if (kClosest && e.tnear > prune) continue;
-      cur = e.node;
-      break;
+      cur = stack[--top];
     }
   }
+}
+
+}  // namespace bvh_detail
+
+// Visits the leaves whose boxes the ray's window meets; `leaf(first_slot,
+// count)` returns true to stop, `leaf_prefetch(first_slot)` may ask for a
+// leaf's data when its box is met. kClosest: nearest box first, `tmax`
+// re-read after every leaf (closest-hit shrinks it) and boxes entered
+// beyond it skipped; otherwise (any hit) in node order, without sorting.
+// The nearest child hit is visited next without going through the stack.
+// Always inlined, so that it is compiled for the ISA of its caller; kFma
+// only from callers compiled for AVX2 and FMA (meet8_fma's instructions).
+template <bool kClosest, bool kFma = false, class T, class Leaf, class LeafPrefetch>
+[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
+                                            Leaf&& leaf, LeafPrefetch&& leaf_prefetch) {
+  using namespace bvh_detail;
+  if (bvh.nodes.empty()) return;
+  const BoxRay r = box_ray(o, d, tmin);
+  if constexpr (kFma) {
+    if (r.fma_ok) return traverse_loop<kClosest, true>(bvh, r, tmax, leaf, leaf_prefetch);
+  }
+  traverse_loop<kClosest, false>(bvh, r, tmax, leaf, leaf_prefetch);
+}
+
+template <bool kClosest, bool kFma = false, class T, class Leaf>
+[[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
+                                            Leaf&& leaf) {
+  traverse<kClosest, kFma>(bvh, o, d, tmin, tmax, leaf, [](std::uint32_t) {});
 }
 
 }  // namespace ra

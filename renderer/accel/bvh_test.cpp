@@ -7,6 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
 #include <memory>
 #include <random>
 
@@ -102,6 +106,76 @@ TEST(Bvh, SameHitsAsEveryTriangleFarFromTheOrigin) {
   int hits = 0;
   compare({148376, 1234, -223423}, 1e4, 2, &hits);
   EXPECT_GT(hits, 1000);
+}
+
+// meet8_fma (the AVX2+FMA path) on its own, against the slab test in long
+// double (64-bit mantissa: exact enough, its error is 2^-40 of the float
+// test's slack): every box the segment [tmin, tmax] meets must be in the
+// mask, and its tnear must not exceed the pruning bound for tmax. Boxes
+// hug points of the ray, or graze it from one side, near and far from the
+// origin.
+[[gnu::target("avx2,fma")]] int fused_mask(const BvhNode& n, const bvh_detail::BoxRay& r, float tmax, float* tnear) {
+  const bvh_detail::BoxRay8 w = bvh_detail::widen(r);
+  bvh_detail::v8f tn;
+  const int m = bvh_detail::meet8_fma(n, w, bvh_detail::splat(tmax), tn);
+  std::memcpy(tnear, &tn, sizeof tn);
+  return m;
+}
+
+bool slab_meets(const Vec3d& o, const Vec3d& d, double tmin, double tmax, const BvhNode& n, int i) {
+  long double lo = tmin, hi = tmax;
+  for (int a = 0; a < 3; ++a) {
+    const long double t0 = ((long double)n.lo[a][i] - o[a]) / d[a], t1 = ((long double)n.hi[a][i] - o[a]) / d[a];
+    lo = std::max(lo, std::min(t0, t1));
+    hi = std::min(hi, std::max(t0, t1));
+  }
+  return lo <= hi;
+}
+
+TEST(Bvh, FusedBoxTestNeverRejectsABoxTheSegmentMeets) {
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) GTEST_SKIP() << "no AVX2+FMA";
+  using bvh_detail::round_down;
+  using bvh_detail::round_up;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1), w(0, 1);
+  int met = 0, rays = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double scale = i % 3 == 0 ? 1 : i % 3 == 1 ? 1e3 : 1e5;
+    const Vec3d o = Vec3d{u(rng), u(rng), u(rng)} * scale;
+    Vec3d d{u(rng), u(rng), u(rng)};
+    if (i % 5 == 1) d[i % 3] *= 1e-6;                  // nearly axis-parallel
+    if (i % 7 == 2) d = d * (i % 2 ? 1e-12 : 1e12);  // tiny and huge |d|
+    const double tmin = i % 4 == 0 ? 0 : w(rng) * 1e-3 * scale / length(d);
+    const double tmax = i % 6 == 0 ? INFINITY : (0.5 + 2 * w(rng)) * scale / length(d);
+    const bvh_detail::BoxRay r = bvh_detail::box_ray(o, d, tmin);
+    if (!r.fma_ok) continue;
+    ++rays;
+    BvhNode n{};
+    for (int c = 0; c < 8; ++c) {
+      // A point of the ray (in long double), a box around it of half-size h,
+      // moved off the ray by h + a hair on one axis half of the time.
+      const long double t = tmin + (long double)w(rng) * (std::isinf(tmax) ? 3 * scale / length(d) : tmax - tmin);
+      const double h = c % 4 == 0 ? 0 : scale * std::pow(10.0, -1 - 7 * w(rng));
+      for (int a = 0; a < 3; ++a) {
+        long double p = o[a] + t * d[a];
+        if (c % 2 && a == c % 3) p += (c & 4 ? 1 : -1) * (h + scale * 1e-9 * w(rng));
+        n.lo[a][c] = round_down(double(p - h));
+        n.hi[a][c] = round_up(double(p + h));
+      }
+    }
+    const float tmax_f = round_up(tmax);
+    float tn[8];
+    const int mask = fused_mask(n, r, tmax_f, tn);
+    const float prune = std::fma(tmax_f, 1 + 4 * Bvh::kRelSlack, r.abs_slack);
+    for (int c = 0; c < 8; ++c) {
+      if (!slab_meets(o, d, tmin, tmax, n, c)) continue;
+      ++met;
+      ASSERT_TRUE((mask >> c) & 1) << "ray " << i << " box " << c;
+      ASSERT_LE(tn[c], prune) << "ray " << i << " box " << c;
+    }
+  }
+  EXPECT_GT(rays, 15000);
+  EXPECT_GT(met, 40000);
 }
 
 }  // namespace

@@ -58,11 +58,26 @@ template <class T>
   return v;
 }
 
+// x in every lane, bit for bit (V{} + x would add +0: a -0 would become +0).
+template <class T>
+[[gnu::always_inline]] inline typename Lanes<T>::V bcast(T x) {
+  return typename Lanes<T>::V{x, x, x, x};
+}
+
+// Is any lane of a comparison's mask set?
+template <class T>
+[[gnu::always_inline]] inline bool any_lane(typename Lanes<T>::M m) {
+  std::int64_t w[sizeof m / 8];
+  __builtin_memcpy(w, &m, sizeof m);
+  if constexpr (sizeof m == 16) return (w[0] | w[1]) != 0;
+  else return ((w[0] | w[1]) | (w[2] | w[3])) != 0;
+}
+
 template <class T>
 [[gnu::always_inline]] inline void hit4(const Ray<T>& r, const Tri4<T>& tri, bool cull, Hit4<T>& out) {
   using V = typename Lanes<T>::V;
   using M = typename Lanes<T>::M;
-  const V dx = V{} + r.d.x, dy = V{} + r.d.y, dz = V{} + r.d.z;
+  const V dx = bcast(r.d.x), dy = bcast(r.d.y), dz = bcast(r.d.z);
   const V ax = load(tri.a[0]), ay = load(tri.a[1]), az = load(tri.a[2]);
   const V e1x = load(tri.e1[0]), e1y = load(tri.e1[1]), e1z = load(tri.e1[2]);
   const V e2x = load(tri.e2[0]), e2y = load(tri.e2[1]), e2z = load(tri.e2[2]);
@@ -70,17 +85,24 @@ template <class T>
   const V px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
   const V det = e1x * px + e1y * py + e1z * pz;
   M ok = cull ? (det > V{}) : (det != V{});
-  const V inv = V{} + T(1) / det;
+  const V inv = T(1) / det;
   // s = o - a
-  const V sx = (V{} + r.o.x) - ax, sy = (V{} + r.o.y) - ay, sz = (V{} + r.o.z) - az;
+  const V sx = bcast(r.o.x) - ax, sy = bcast(r.o.y) - ay, sz = bcast(r.o.z) - az;
   const V u = (sx * px + sy * py + sz * pz) * inv;
   ok &= (u >= V{}) & (u <= V{} + T(1));
+  // Most leaf tests miss every lane by here (shadow rays leaving the
+  // surface, rays passing a leaf's box): skip the rest, whose only effect
+  // is to reject more lanes.
+  if (!any_lane<T>(ok)) {
+    out.hits = 0;
+    return;
+  }
   // q = cross(s, e1)
   const V qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
   const V v = (dx * qx + dy * qy + dz * qz) * inv;
   ok &= (v >= V{}) & (u + v <= V{} + T(1));
   const V t = (e2x * qx + e2y * qy + e2z * qz) * inv;
-  ok &= (t >= V{} + r.tmin) & (t <= V{} + r.tmax);
+  ok &= (t >= bcast(r.tmin)) & (t <= bcast(r.tmax));
   int hits = 0;
   for (int i = 0; i < 4; ++i) hits |= ok[i] ? 1 << i : 0;
   out.hits = hits;
