@@ -103,31 +103,34 @@ struct Bins {
   }
 };
 
-// Bins p[0, n) into `out` (cleared here). Two sets, even and odd primitives,
-// merged after: consecutive primitives often fall in the same bin, and one
-// set would chain every update on the previous one's store.
+// Bins p[0, n) into `out` (cleared here). Large ranges use two sets, even
+// and odd primitives, merged after: consecutive primitives often fall in the
+// same bin, and one set would chain every update on the previous one's
+// store; small ones one set (clearing and merging a second would cost more).
 void bin_prims(const PrimRef* p, std::uint32_t n, const Binner& bn, Bins& out) {
-  Bins other;
   out.clear(bn.nb);
-  other.clear(bn.nb);
   std::uint32_t i = 0;
-  for (; i + 1 < n; i += 2) {
-    const v4i b = bn.bin(p[i]), c = bn.bin(p[i + 1]);
-    for (int a = 0; a < 3; ++a) {
-      out.box[a][b[a]].grow(p[i].lo, p[i].hi);
-      ++out.count[a][b[a]];
-      other.box[a][c[a]].grow(p[i + 1].lo, p[i + 1].hi);
-      ++other.count[a][c[a]];
+  if (n >= 64) {
+    Bins other;
+    other.clear(bn.nb);
+    for (; i + 1 < n; i += 2) {
+      const v4i b = bn.bin(p[i]), c = bn.bin(p[i + 1]);
+      for (int a = 0; a < 3; ++a) {
+        out.box[a][b[a]].grow(p[i].lo, p[i].hi);
+        ++out.count[a][b[a]];
+        other.box[a][c[a]].grow(p[i + 1].lo, p[i + 1].hi);
+        ++other.count[a][c[a]];
+      }
     }
+    out.merge(other, bn.nb);
   }
-  if (i < n) {
+  for (; i < n; ++i) {
     const v4i b = bn.bin(p[i]);
     for (int a = 0; a < 3; ++a) {
       out.box[a][b[a]].grow(p[i].lo, p[i].hi);
       ++out.count[a][b[a]];
     }
   }
-  out.merge(other, bn.nb);
 }
 
 // Moves src[0, n) to dst: those left of the split to dst[l, ...) in order,
@@ -361,22 +364,26 @@ struct Builder {
   // returns its index. `top`: ranges below task_below become tasks.
   std::uint32_t emit(const Range& r, Out out, bool top) {
     Range kids[Bvh::kWidth];
+    float area[Bvh::kWidth];
     int n = 1;
     kids[0] = r;
+    area[0] = r.box.half_area();
     // The child with the largest box is split next (the root always is,
     // unless it is a leaf: a lone leaf gets a node too).
     while (n < Bvh::kWidth) {
       int best = -1;
       float best_area = -1;
       for (int i = 0; i < n; ++i)
-        if (kids[i].size() > std::uint32_t(Bvh::kMaxLeaf) && kids[i].box.half_area() > best_area) {
-          best_area = kids[i].box.half_area();
+        if (kids[i].size() > std::uint32_t(Bvh::kMaxLeaf) && area[i] > best_area) {
+          best_area = area[i];
           best = i;
         }
       if (best < 0) break;
       Range a, b;
       split(kids[best], a, b);
       kids[best] = a;
+      area[best] = a.box.half_area();
+      area[n] = b.box.half_area();
       kids[n++] = b;
     }
     const std::uint32_t me = std::uint32_t(out.nodes.size());
