@@ -8,6 +8,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <deque>
+#include <functional>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -162,64 +164,126 @@ void bounds(const PrimRef* p, std::uint32_t n, Box& box, Box& cbox) {
   }
 }
 
-// A minimal pool for one build: the thread that runs build() posts a
-// section (count chunks of work) and takes part in it; the others wait for
-// the next section. Each section lives until the build ends, so a late
-// worker never reads a newer one's fields.
+// A minimal pool for one build. The thread that runs build() posts
+// sections (count chunks of work) and takes part in them, and posts subtree
+// tasks, which the others take while it goes on with the top of the tree.
+// Each section lives until the build ends, so a late worker never reads a
+// newer one's fields.
 class Pool {
  public:
   struct Section {
     const std::function<void(std::uint32_t)>* fn;
     std::uint32_t count;
     std::atomic<std::uint32_t> next{0}, done{0};
-    bool quit = false;
   };
 
+  // Runs fn(0 .. count-1) on this thread and any idle ones; returns when all
+  // are done.
   void run(std::uint32_t count, const std::function<void(std::uint32_t)>& fn) {
     if (count == 0) return;
-    sections_.push_back(std::make_unique<Section>());
-    Section* s = sections_.back().get();
+    Section* s;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      sections_.push_back(std::make_unique<Section>());
+      s = sections_.back().get();
+    }
     s->fn = &fn;
     s->count = count;
     if (count > 1) {
       cur_.store(s);
-      cur_.notify_all();
+      wake();
     }
     work(s);
     for (std::uint32_t d; (d = s->done.load()) != count;) s->done.wait(d);
-    if (error_) std::rethrow_exception(error_);
+    rethrow();
+  }
+  void post(std::function<void()> task) {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      queue_.push_back(std::move(task));
+      ++posted_;
+    }
+    wake();
+  }
+  // Takes part in the posted tasks until all are done.
+  void finish_tasks() {
+    for (;;) {
+      const std::uint32_t e = epoch_.load();
+      if (run_task()) continue;
+      if (finished_.load() == posted_count()) break;
+      epoch_.wait(e);
+    }
+    rethrow();
   }
   void quit() {
-    sections_.push_back(std::make_unique<Section>());
-    sections_.back()->quit = true;
-    cur_.store(sections_.back().get());
-    cur_.notify_all();
+    quit_.store(true);
+    wake();
   }
   void worker_loop() {
-    Section* seen = nullptr;
     for (;;) {
-      cur_.wait(seen);
-      seen = cur_.load();
-      if (seen->quit) return;
-      work(seen);
+      const std::uint32_t e = epoch_.load();
+      if (quit_.load()) return;
+      Section* s = cur_.load();
+      if (s && s->next.load() < s->count) {
+        work(s);
+        continue;
+      }
+      if (run_task()) continue;
+      epoch_.wait(e);
     }
   }
 
  private:
+  void wake() {
+    epoch_.fetch_add(1);
+    epoch_.notify_all();
+  }
+  std::uint32_t posted_count() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return posted_;
+  }
+  void failed() {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (!error_) error_ = std::current_exception();
+  }
+  void rethrow() {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (error_) std::rethrow_exception(error_);
+  }
   void work(Section* s) {
     for (std::uint32_t i; (i = s->next.fetch_add(1)) < s->count;) {
       try {
         (*s->fn)(i);
       } catch (...) {
-        std::lock_guard<std::mutex> lock(mu_);
-        if (!error_) error_ = std::current_exception();
+        failed();
       }
       if (s->done.fetch_add(1) + 1 == s->count) s->done.notify_all();
     }
   }
+  bool run_task() {
+    std::function<void()> t;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (queue_.empty()) return false;
+      t = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    try {
+      t();
+    } catch (...) {
+      failed();
+    }
+    finished_.fetch_add(1);
+    wake();
+    return true;
+  }
+  std::atomic<std::uint32_t> epoch_{0}, finished_{0};
+  std::atomic<bool> quit_{false};
   std::atomic<Section*> cur_{nullptr};
-  std::vector<std::unique_ptr<Section>> sections_;
   std::mutex mu_;
+  std::vector<std::unique_ptr<Section>> sections_;
+  std::deque<std::function<void()>> queue_;
+  std::uint32_t posted_ = 0;
   std::exception_ptr error_;
 };
 
@@ -231,7 +295,8 @@ struct Out {
   std::vector<std::uint32_t>& order;
 };
 
-// A subtree left for the task phase: its range, and the child word it fills.
+// A subtree left to a task: its range, the child word it fills, and what
+// it builds.
 struct Task {
   Range range;
   std::uint32_t node, slot;
@@ -353,6 +418,14 @@ struct Builder {
     rr = Range{r.begin + mid, r.end, 1 - r.buf, r.depth + 1, rb, rcb};
   }
 
+  // A subtree below the top, on one thread into the task's own vectors.
+  void run_task(Task& t) const {
+    t.nodes.reserve(t.range.size() / 8 + 1);
+    t.order.reserve(4 * (t.range.size() / 2 + 1));
+    Builder sub{{buf[0], buf[1]}, pad, pool, 1, 0, {}};
+    sub.emit(t.range, Out{t.nodes, t.order}, false);
+  }
+
   // A leaf's triangles go to the next 4 slots (unused ones hold kNoTriangle).
   static std::uint32_t emit_leaf(const PrimRef* p, std::uint32_t n, std::vector<std::uint32_t>& order) {
     const std::uint32_t k = std::uint32_t(order.size() / 4);
@@ -397,9 +470,11 @@ struct Builder {
         child[i] = emit_leaf(buf[k.buf] + k.begin, k.size(), out.order);
       } else if (top && k.size() < task_below) {
         tasks.push_back(std::make_unique<Task>());
-        tasks.back()->range = k;
-        tasks.back()->node = me;
-        tasks.back()->slot = std::uint32_t(i);
+        Task* t = tasks.back().get();
+        t->range = k;
+        t->node = me;
+        t->slot = std::uint32_t(i);
+        pool->post([this, t] { run_task(*t); });
       } else {
         child[i] = emit(k, out, top);
       }
@@ -438,10 +513,12 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
   PrimRef* const b = a + n + 64;
   Pool pool;
   Builder bld{{a, b}, pad, &pool, threads, 0, {}};
-  // The top of the tree is built by one thread (its large splits by all),
-  // then the subtrees below task_below by all, each into its own vectors.
-  // A function of n only, so the tree is the same for every thread count.
-  bld.task_below = std::uint32_t(std::max<std::size_t>(4096, n / 64));
+  // The top of the tree is built by one thread (its large splits by all);
+  // the subtrees below task_below are tasks the others take meanwhile,
+  // each built into its own vectors and placed after the top's nodes in the
+  // order the top met them. A function of n only, so the tree is the same
+  // for every thread count.
+  bld.task_below = std::uint32_t(std::max<std::size_t>(2048, n / 128));
   auto top = [&] {
     const std::uint32_t chunks = std::uint32_t((n + kChunk - 1) / kChunk);
     std::vector<Box> cb(2 * chunks, Box::empty());
@@ -468,19 +545,7 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
     bvh.nodes.reserve(n / 8 + 1);
     bvh.order.reserve(4 * (n / 2 + 1));
     bld.emit(root, Out{bvh.nodes, bvh.order}, true);
-    // Largest first, so that no thread is left with a big one at the end.
-    std::vector<Task*> by_size;
-    for (auto& t : bld.tasks) by_size.push_back(t.get());
-    std::stable_sort(by_size.begin(), by_size.end(),
-                     [](const Task* x, const Task* y) { return x->range.size() > y->range.size(); });
-    const std::function<void(std::uint32_t)> run_task = [&](std::uint32_t i) {
-      Task& t = *by_size[i];
-      t.nodes.reserve(t.range.size() / 8 + 1);
-      t.order.reserve(4 * (t.range.size() / 2 + 1));
-      Builder sub{{a, b}, pad, &pool, 1, 0, {}};
-      sub.emit(t.range, Out{t.nodes, t.order}, false);
-    };
-    pool.run(std::uint32_t(by_size.size()), run_task);
+    pool.finish_tasks();
     // The tasks' nodes and leaves after the top's, in the order the top
     // met them.
     std::vector<std::uint32_t> node_off(bld.tasks.size()), leaf_off(bld.tasks.size());
@@ -492,7 +557,6 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
       slots += bld.tasks[i]->order.size();
       bvh.nodes[bld.tasks[i]->node].child[bld.tasks[i]->slot] = node_off[i];
     }
-    const std::size_t top_nodes = bvh.nodes.size(), top_slots = bvh.order.size();
     bvh.nodes.resize(nodes);
     bvh.order.resize(slots);
     const std::function<void(std::uint32_t)> place = [&](std::uint32_t i) {
@@ -506,8 +570,6 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
       std::vector<BvhNode>().swap(t.nodes);
       std::vector<std::uint32_t>().swap(t.order);
     };
-    (void)top_nodes;
-    (void)top_slots;
     pool.run(std::uint32_t(bld.tasks.size()), place);
   };
   std::atomic<int> ids{0};
