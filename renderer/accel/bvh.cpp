@@ -24,10 +24,12 @@ namespace {
 // kMaxSahDepth + 32 binary levels, within the traversal stack (Bvh::kMaxDepth).
 constexpr int kMaxSahDepth = 64;
 // Splits of ranges at least this large are binned and partitioned by all
-// threads (the results are exact, so the same as on one thread).
-constexpr std::uint32_t kParallelSplit = 1u << 15;
+// threads (the results are exact, so the same as on one thread); below it,
+// the other threads are busy with subtree tasks, and a shared pass would
+// only add waits for each other.
+constexpr std::uint32_t kParallelSplit = 1u << 17;
 // Primitives per chunk when a pass is spread over threads.
-constexpr std::uint32_t kChunk = 1u << 14;
+constexpr std::uint32_t kChunk = 1u << 15;
 
 typedef float v4f __attribute__((vector_size(16)));
 typedef int v4i __attribute__((vector_size(16)));
@@ -154,6 +156,19 @@ void partition(const PrimRef* src, std::uint32_t n, const Binner& bn, int axis, 
       rcb.grow(c, c);
     }
   }
+}
+
+// round_down / round_up of bvh.h, 4 lanes at once (lane 3 unused).
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
+v4f round4(v4d x, bool up) {
+  const v4f f = __builtin_convertvector(x, v4f);
+  const v4d back = __builtin_convertvector(f, v4d);
+  const v4i off = __builtin_convertvector(up ? (v4l)(back < x) : (v4l)(back > x), v4i);
+  const v4f grow = v4f{} + (up ? 1 + 0x1p-23f : 1 - 0x1p-23f), shrink = v4f{} + (up ? 1 - 0x1p-23f : 1 + 0x1p-23f);
+  const v4f tiny = v4f{} + (up ? 1e-30f : -1e-30f);
+  const v4f big = f > 1e-30f ? f * grow : f < -1e-30f ? f * shrink : f + tiny;
+  return off ? big : f;
 }
 
 void bounds(const PrimRef* p, std::uint32_t n, Box& box, Box& cbox) {
@@ -474,7 +489,7 @@ struct Builder {
         t->range = k;
         t->node = me;
         t->slot = std::uint32_t(i);
-        pool->post([this, t] { run_task(*t); });
+        if (threads > 1) pool->post([this, t] { run_task(*t); });
       } else {
         child[i] = emit(k, out, top);
       }
@@ -526,10 +541,8 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
       const std::size_t end = std::min(n, std::size_t(c + 1) * kChunk);
       for (std::size_t i = std::size_t(c) * kChunk; i < end; ++i) {
         PrimRef& p = a[i];
-        for (int k = 0; k < 3; ++k) {
-          p.lo[k] = bvh_detail::round_down(lo[i][k]);
-          p.hi[k] = bvh_detail::round_up(hi[i][k]);
-        }
+        p.lo = round4(v4d{lo[i].x, lo[i].y, lo[i].z, 0}, false);
+        p.hi = round4(v4d{hi[i].x, hi[i].y, hi[i].z, 0}, true);
         const std::uint32_t id = std::uint32_t(i);
         __builtin_memcpy(reinterpret_cast<char*>(&p.lo) + 12, &id, 4);
         p.hi[3] = 0;
@@ -545,6 +558,16 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
     bvh.nodes.reserve(n / 8 + 1);
     bvh.order.reserve(4 * (n / 2 + 1));
     bld.emit(root, Out{bvh.nodes, bvh.order}, true);
+    if (threads == 1) {
+      // The tasks in order, straight after the top: where the copies below
+      // would put them.
+      for (auto& t : bld.tasks) {
+        bvh.nodes[t->node].child[t->slot] = std::uint32_t(bvh.nodes.size());
+        Builder sub{{a, b}, pad, &pool, 1, 0, {}};
+        sub.emit(t->range, Out{bvh.nodes, bvh.order}, false);
+      }
+      return;
+    }
     pool.finish_tasks();
     // The tasks' nodes and leaves after the top's, in the order the top
     // met them.
