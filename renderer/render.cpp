@@ -214,10 +214,9 @@ struct Tracer::Impl {
     m.bvh = Bvh::build(lo, hi, 1e-5 * size, opt.threads);
     const std::size_t slots = m.bvh.order.size();
     if (bvh_tri4()) {
-      m.tri4.resize(slots / 4);
+      m.tri4.resize(slots / 4);  // zeros: an unused lane is never hit
       parallel_chunks(slots / 4, [&](std::size_t begin, std::size_t end) {
         for (std::size_t l = begin; l < end; ++l) {
-          m.tri4[l] = moller_simd::Tri4<T>{};
           for (int j = 0; j < 4; ++j) {
             const std::uint32_t t = m.bvh.order[4 * l + std::size_t(j)];
             if (t == Bvh::kNoTriangle) continue;
