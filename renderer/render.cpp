@@ -202,16 +202,17 @@ struct Tracer::Impl {
   void build_bvh(PreparedMesh<T>& m, const TriangleKernels<T>& k, const Vec3d& mesh_lo, const Vec3d& mesh_hi) const {
     const TriangleSet& set = *m.set;
     const std::size_t n = set.triangles.size();
-    std::vector<Vec3d> lo(n), hi(n);
-    parallel_chunks(n, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const auto& t = set.triangles[i];
-        lo[i] = vmin(set.positions[t.v[0]], vmin(set.positions[t.v[1]], set.positions[t.v[2]]));
-        hi[i] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
-      }
-    });
     const double size = std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
-    m.bvh = Bvh::build(lo, hi, 1e-5 * size, opt.threads);
+    m.bvh = Bvh::build(
+        n,
+        [&](std::size_t begin, std::size_t end, Vec3d* lo, Vec3d* hi) {
+          for (std::size_t i = begin; i < end; ++i) {
+            const auto& t = set.triangles[i];
+            lo[i - begin] = vmin(set.positions[t.v[0]], vmin(set.positions[t.v[1]], set.positions[t.v[2]]));
+            hi[i - begin] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
+          }
+        },
+        1e-5 * size, opt.threads);
     const std::size_t slots = m.bvh.order.size();
     if (bvh_tri4()) {
       m.tri4.resize(slots / 4);  // zeros: an unused lane is never hit

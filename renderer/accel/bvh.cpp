@@ -497,9 +497,14 @@ struct Builder {
     BvhNode& node = out.nodes[me];
     for (int i = 0; i < Bvh::kWidth; ++i) {
       node.child[i] = child[i];
+      v4f lo = v4f{} + INFINITY, hi = v4f{} - INFINITY;
+      if (i < n) {
+        lo = round4(__builtin_convertvector(kids[i].box.lo, v4d) - pad, false);
+        hi = round4(__builtin_convertvector(kids[i].box.hi, v4d) + pad, true);
+      }
       for (int a = 0; a < 3; ++a) {
-        node.lo[a][i] = i < n ? bvh_detail::round_down(double(kids[i].box.lo[a]) - pad) : INFINITY;
-        node.hi[a][i] = i < n ? bvh_detail::round_up(double(kids[i].box.hi[a]) + pad) : -INFINITY;
+        node.lo[a][i] = lo[a];
+        node.hi[a][i] = hi[a];
       }
     }
     return me;
@@ -515,8 +520,17 @@ std::uint32_t shifted(std::uint32_t c, std::uint32_t node_off, std::uint32_t lea
 }  // namespace
 
 Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, double pad, int threads) {
+  return build(
+      lo.size(),
+      [&](std::size_t begin, std::size_t end, Vec3d* l, Vec3d* h) {
+        std::copy(lo.begin() + std::ptrdiff_t(begin), lo.begin() + std::ptrdiff_t(end), l);
+        std::copy(hi.begin() + std::ptrdiff_t(begin), hi.begin() + std::ptrdiff_t(end), h);
+      },
+      pad, threads);
+}
+
+Bvh Bvh::build(std::size_t n, const BoxFn& boxes, double pad, int threads) {
   Bvh bvh;
-  const std::size_t n = lo.size();
   if (n == 0) return bvh;
   if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
   // Two buffers, uninitialised: splits move primitives from one to the
@@ -539,13 +553,21 @@ Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, doubl
     std::vector<Box> cb(2 * chunks, Box::empty());
     const std::function<void(std::uint32_t)> refs = [&](std::uint32_t c) {
       const std::size_t end = std::min(n, std::size_t(c + 1) * kChunk);
-      for (std::size_t i = std::size_t(c) * kChunk; i < end; ++i) {
-        PrimRef& p = a[i];
-        p.lo = round4(v4d{lo[i].x, lo[i].y, lo[i].z, 0}, false);
-        p.hi = round4(v4d{hi[i].x, hi[i].y, hi[i].z, 0}, true);
-        const std::uint32_t id = std::uint32_t(i);
-        __builtin_memcpy(reinterpret_cast<char*>(&p.lo) + 12, &id, 4);
-        p.hi[3] = 0;
+      constexpr std::size_t kPiece = 512;
+      Vec3d lo[kPiece], hi[kPiece];
+      for (std::size_t b0 = std::size_t(c) * kChunk; b0 < end; b0 += kPiece) {
+        const std::size_t e0 = std::min(end, b0 + kPiece);
+        boxes(b0, e0, lo, hi);
+        for (std::size_t i = b0; i < e0; ++i) {
+          PrimRef& p = a[i];
+          const Vec3d& l = lo[i - b0];
+          const Vec3d& h = hi[i - b0];
+          p.lo = round4(v4d{l.x, l.y, l.z, 0}, false);
+          p.hi = round4(v4d{h.x, h.y, h.z, 0}, true);
+          const std::uint32_t id = std::uint32_t(i);
+          __builtin_memcpy(reinterpret_cast<char*>(&p.lo) + 12, &id, 4);
+          p.hi[3] = 0;
+        }
       }
       bounds(&a[std::size_t(c) * kChunk], std::uint32_t(end - std::size_t(c) * kChunk), cb[2 * c], cb[2 * c + 1]);
     };

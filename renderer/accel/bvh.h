@@ -37,6 +37,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -77,6 +78,11 @@ struct Bvh {
   // Uses up to `threads` threads (0: all cores); the tree (nodes and order,
   // byte for byte) does not depend on the thread count.
   static Bvh build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, double pad, int threads = 0);
+  // The same with triangles [begin, end)'s boxes written by `boxes` to
+  // lo[0 .. end - begin) and hi[...] on the build's threads, a piece at a
+  // time (no array of all the boxes).
+  using BoxFn = std::function<void(std::size_t begin, std::size_t end, Vec3d* lo, Vec3d* hi)>;
+  static Bvh build(std::size_t n, const BoxFn& boxes, double pad, int threads = 0);
 };
 
 namespace bvh_detail {
