@@ -19,6 +19,7 @@
 #include "accel/bvh.h"
 #include "camera.h"
 #include "errors.h"
+#include "huge_pages.h"
 #include "methods/moller_simd.h"
 #include "pov_mesh.h"
 #include "registry.h"
@@ -164,6 +165,8 @@ struct Tracer::Impl {
     m.stride = k.pre_bytes;
     const bool pre = !bvh_tri4();
     if (pre) m.pre.resize(m.stride * set.triangles.size());
+    m.gnormal.reserve(set.triangles.size());
+    advise_huge_pages(m.gnormal.data(), set.triangles.size() * sizeof(Vec3d));
     m.gnormal.resize(set.triangles.size());
     parallel_chunks(set.triangles.size(), [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
@@ -215,6 +218,8 @@ struct Tracer::Impl {
         1e-5 * size, opt.threads);
     const std::size_t slots = m.bvh.order.size();
     if (bvh_tri4()) {
+      m.tri4.reserve(slots / 4);
+      advise_huge_pages(m.tri4.data(), slots / 4 * sizeof(m.tri4[0]));
       m.tri4.resize(slots / 4);  // zeros: an unused lane is never hit
       parallel_chunks(slots / 4, [&](std::size_t begin, std::size_t end) {
         for (std::size_t l = begin; l < end; ++l) {

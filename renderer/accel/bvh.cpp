@@ -15,6 +15,7 @@
 #include <mutex>
 #include <thread>
 
+#include "../huge_pages.h"
 #include "../workers.h"
 
 namespace ra {
@@ -538,6 +539,7 @@ Bvh Bvh::build(std::size_t n, const BoxFn& boxes, double pad, int threads) {
   // a recent store 4 KiB apart would falsely wait for each other (4K
   // aliasing), and a split streams both at about the same offsets.
   std::unique_ptr<PrimRef[]> store(new PrimRef[2 * n + 64]);
+  advise_huge_pages(store.get(), sizeof(PrimRef) * (2 * n + 64));
   PrimRef* const a = store.get();
   PrimRef* const b = a + n + 64;
   Pool pool;
@@ -578,6 +580,7 @@ Bvh Bvh::build(std::size_t n, const BoxFn& boxes, double pad, int threads) {
       root.cbox.grow(cb[2 * c + 1]);
     }
     bvh.nodes.reserve(n / 8 + 1);
+    advise_huge_pages(bvh.nodes.data(), (n / 8 + 1) * sizeof(BvhNode));
     bvh.order.reserve(4 * (n / 2 + 1));
     bld.emit(root, Out{bvh.nodes, bvh.order}, true);
     if (threads == 1) {
