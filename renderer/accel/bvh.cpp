@@ -24,13 +24,14 @@ namespace {
 // Past this binary depth splits are halvings: the tree is never deeper than
 // kMaxSahDepth + 32 binary levels, within the traversal stack (Bvh::kMaxDepth).
 constexpr int kMaxSahDepth = 64;
-// Splits of ranges at least this large are binned and partitioned by all
-// threads (the results are exact, so the same as on one thread); below it,
-// the other threads are busy with subtree tasks, and a shared pass would
-// only add waits for each other.
-constexpr std::uint32_t kParallelSplit = 1u << 17;
-// Primitives per chunk when a pass is spread over threads.
-constexpr std::uint32_t kChunk = 1u << 15;
+// Splits of the largest ranges (the first levels, before there are subtree
+// tasks to share) are binned and partitioned by all threads, in chunks; the
+// results are exact, so the same as on one thread. Both sizes follow the
+// mesh: n / 8 and n / 32 triangles, within [16K, 128K] and [2K, 32K].
+std::uint32_t parallel_split_size(std::size_t n) {
+  return std::uint32_t(std::clamp<std::size_t>(n / 8, 1u << 14, 1u << 17));
+}
+std::uint32_t chunk_size(std::size_t n) { return std::uint32_t(std::clamp<std::size_t>(n / 32, 1u << 11, 1u << 15)); }
 
 typedef float v4f __attribute__((vector_size(16)));
 typedef int v4i __attribute__((vector_size(16)));
@@ -326,6 +327,7 @@ struct Builder {
   Pool* pool;
   int threads;
   std::uint32_t task_below;  // the top phase leaves ranges smaller than this to tasks
+  std::uint32_t parallel_split, chunk;
   std::vector<std::unique_ptr<Task>> tasks;
 
   // Splits r into l and rr (binned SAH; halving when SAH finds no split).
@@ -344,7 +346,8 @@ struct Builder {
       const float extent = r.cbox.hi[a] - r.cbox.lo[a];
       bn.k[a] = extent > 0 ? float(bn.nb) * (1 - 0x1p-20f) / extent : 0.f;
     }
-    const bool par = threads > 1 && n >= kParallelSplit;
+    const bool par = threads > 1 && n >= parallel_split;
+    const std::uint32_t kChunk = chunk;
     const std::uint32_t chunks = par ? (n + kChunk - 1) / kChunk : 1;
     std::vector<Bins> chunk_bins(par ? chunks : 0);
     Bins bins;
@@ -439,7 +442,7 @@ struct Builder {
   void run_task(Task& t) const {
     t.nodes.reserve(t.range.size() / 8 + 1);
     t.order.reserve(4 * (t.range.size() / 2 + 1));
-    Builder sub{{buf[0], buf[1]}, pad, pool, 1, 0, {}};
+    Builder sub{{buf[0], buf[1]}, pad, pool, 1, 0, 0, 0, {}};
     sub.emit(t.range, Out{t.nodes, t.order}, false);
   }
 
@@ -544,7 +547,8 @@ Bvh Bvh::build(std::size_t n, const BoxFn& boxes, double pad, int threads) {
   PrimRef* const a = store.get();
   PrimRef* const b = a + n + 64;
   Pool pool;
-  Builder bld{{a, b}, pad, &pool, threads, 0, {}};
+  Builder bld{{a, b}, pad, &pool, threads, 0, parallel_split_size(n), chunk_size(n), {}};
+  const std::size_t kChunk = bld.chunk;
   // The top of the tree is built by one thread (its large splits by all);
   // the subtrees below task_below are tasks the others take meanwhile,
   // each built into its own vectors and placed after the top's nodes in the
@@ -589,7 +593,7 @@ Bvh Bvh::build(std::size_t n, const BoxFn& boxes, double pad, int threads) {
       // would put them.
       for (auto& t : bld.tasks) {
         bvh.nodes[t->node].child[t->slot] = std::uint32_t(bvh.nodes.size());
-        Builder sub{{a, b}, pad, &pool, 1, 0, {}};
+        Builder sub{{a, b}, pad, &pool, 1, 0, 0, 0, {}};
         sub.emit(t->range, Out{bvh.nodes, bvh.order}, false);
       }
       return;
