@@ -1,7 +1,9 @@
 // Builds renderer/accel/bvh.h's 8-wide BVH directly, as Embree's BVHN
 // builder does: binned SAH splits (Wald 2007), the child with the largest box
 // split next until a node has 8 children; on all threads, the tree not
-// depending on their number.
+// depending on their number. Guarantee: every triangle in exactly one leaf,
+// and every child box holds its triangles' boxes (rounded outward to float
+// from double, then padded by `pad` and rounded outward again).
 #include "bvh.h"
 
 #include <algorithm>
