@@ -128,13 +128,16 @@ EmbreeScene& scene_for(const Rung& r, bool robust, int threads) {
 
 const char* flag_name(bool robust) { return robust ? "robust" : "default"; }
 
-// Build: ours (the BVH tracer, always one thread) and Embree's, back to back.
+// Build: ours (the BVH tracer: kernel data, boxes, BVH) and Embree's (vertex
+// and index buffers, rtcCommitScene), back to back, on the same number of
+// threads.
 void bm_build(benchmark::State& state, const Rung* rung, bool robust, int threads) {
   const ra::TriangleSet& mesh = *rung_rays(*rung).mesh;
   double ours = 0, theirs = 0, bpt = 0, ours_bpt = 0;
   for (auto _ : state) {
     ra::RenderOptions opt;
     opt.progress = false;
+    opt.threads = threads;
     const long before = heap_live();
     const auto t0 = now();
     {

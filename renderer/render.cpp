@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <system_error>
 #include <thread>
@@ -18,6 +19,7 @@
 #include "accel/bvh.h"
 #include "scene/camera.h"
 #include "errors.h"
+#include "huge_pages.h"
 #include "methods/moller_simd.h"
 #include "pov_mesh.h"
 #include "registry.h"
@@ -49,8 +51,9 @@ constexpr double kMinCosIncidence = 1e-10;
 // A mesh ready for tracing at precision T: each triangle's prepared bytes
 // for the chosen method, its unit geometric normal, and the bounding sphere
 // of document 002's optimisation. With --accel bvh the prepared bytes are
-// stored in the BVH's slot order (bvh.order maps a slot to its triangle), and
-// for moller its leaves also as 4-lane blocks (methods/moller_simd.h).
+// stored in the BVH's slot order (bvh.order maps a slot to its triangle),
+// except for moller, whose leaves are 4-lane blocks instead
+// (methods/moller_simd.h; `pre` stays empty).
 template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
@@ -140,24 +143,50 @@ struct Tracer::Impl {
     }
   }
 
+  // moller's 4-lane form answers bit for bit as its scalar one: with the
+  // BVH its leaves are tested from tri4 alone, and the per-triangle bytes
+  // are not made.
+  bool bvh_tri4() const { return opt.accel == Accel::bvh && tri_method->name == "moller"; }
+
+  // f(begin, end) over [0, n) in chunks on the tracer's threads; on this
+  // one below 2 chunks (starting threads would cost more). The results
+  // never depend on the split.
+  void parallel_chunks(std::size_t n, const std::function<void(std::size_t, std::size_t)>& f) const {
+    constexpr std::size_t kChunk = 16384;
+    const int threads = opt.threads > 0 ? opt.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    if (threads == 1 || n < 2 * kChunk) {
+      f(0, n);
+      return;
+    }
+    std::atomic<std::size_t> next{0};
+    run_workers(int(std::min<std::size_t>(std::size_t(threads), (n + kChunk - 1) / kChunk)), [&] {
+      for (std::size_t b; (b = next.fetch_add(kChunk)) < n;) f(b, std::min(n, b + kChunk));
+    });
+  }
+
   template <class T>
   PreparedMesh<T> prepare(const TriangleSet& set) const {
     PreparedMesh<T> m;
     m.set = &set;
     const auto& k = tri_method->triangle<T>();
     m.stride = k.pre_bytes;
-    m.pre.resize(m.stride * set.triangles.size());
+    const bool pre = !bvh_tri4();
+    if (pre) m.pre.resize(m.stride * set.triangles.size());
+    m.gnormal.reserve(set.triangles.size());
+    advise_huge_pages(m.gnormal.data(), set.triangles.size() * sizeof(Vec3d));
     m.gnormal.resize(set.triangles.size());
-    for (std::size_t i = 0; i < set.triangles.size(); ++i) {
-      const auto& tri = set.triangles[i];
-      const Vec3d& a = set.positions[tri.v[0]];
-      const Vec3d& b = set.positions[tri.v[1]];
-      const Vec3d& c = set.positions[tri.v[2]];
-      k.prepare(Vec3<T>(a), Vec3<T>(b), Vec3<T>(c), m.pre.data() + i * m.stride);
-      const Vec3d n = cross(b - a, c - a);  // length = twice the area
-      const double len = length(n);
-      m.gnormal[i] = len > 0 ? n / len : Vec3d{0, 0, 0};
-    }
+    parallel_chunks(set.triangles.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const auto& tri = set.triangles[i];
+        const Vec3d& a = set.positions[tri.v[0]];
+        const Vec3d& b = set.positions[tri.v[1]];
+        const Vec3d& c = set.positions[tri.v[2]];
+        if (pre) k.prepare(Vec3<T>(a), Vec3<T>(b), Vec3<T>(c), m.pre.data() + i * m.stride);
+        const Vec3d n = cross(b - a, c - a);  // length = twice the area
+        const double len = length(n);
+        m.gnormal[i] = len > 0 ? n / len : Vec3d{0, 0, 0};
+      }
+    });
     if (set.shading == Shading::smooth) m.vertex_normal = area_weighted_vertex_normals(set);
     Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
     for (const auto& p : set.positions) {
@@ -183,30 +212,45 @@ struct Tracer::Impl {
   void build_bvh(PreparedMesh<T>& m, const TriangleKernels<T>& k, const Vec3d& mesh_lo, const Vec3d& mesh_hi) const {
     const TriangleSet& set = *m.set;
     const std::size_t n = set.triangles.size();
-    std::vector<Vec3d> lo(n), hi(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& t = set.triangles[i];
-      lo[i] = vmin(set.positions[t.v[0]], vmin(set.positions[t.v[1]], set.positions[t.v[2]]));
-      hi[i] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
-    }
     const double size = std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
-    m.bvh = Bvh::build(lo, hi, 1e-5 * size, opt.threads);
+    m.bvh = Bvh::build(
+        n,
+        [&](std::size_t begin, std::size_t end, Vec3d* lo, Vec3d* hi) {
+          for (std::size_t i = begin; i < end; ++i) {
+            const auto& t = set.triangles[i];
+            lo[i - begin] = vmin(set.positions[t.v[0]], vmin(set.positions[t.v[1]], set.positions[t.v[2]]));
+            hi[i - begin] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
+          }
+        },
+        1e-5 * size, opt.threads);
     const std::size_t slots = m.bvh.order.size();
-    std::vector<unsigned char> pre(slots * m.stride, 0);
-    for (std::size_t s = 0; s < slots; ++s)
-      if (m.bvh.order[s] != Bvh::kNoTriangle)
-        std::memcpy(pre.data() + s * m.stride, m.pre.data() + std::size_t(m.bvh.order[s]) * m.stride, m.stride);
-    m.pre = std::move(pre);
-    // moller has a 4-lane form that answers bit for bit as the scalar one.
-    if (tri_method->name == "moller") {
-      m.tri4.assign(slots / 4, moller_simd::Tri4<T>{});
-      for (std::size_t s = 0; s < slots; ++s) {
-        if (m.bvh.order[s] == Bvh::kNoTriangle) continue;
-        const auto& tri = set.triangles[m.bvh.order[s]];
-        m.tri4[s / 4].set(int(s % 4), Vec3<T>(set.positions[tri.v[0]]), Vec3<T>(set.positions[tri.v[1]]),
+    if (bvh_tri4()) {
+      m.tri4.reserve(slots / 4);
+      advise_huge_pages(m.tri4.data(), slots / 4 * sizeof(m.tri4[0]));
+      m.tri4.resize(slots / 4);  // zeros: an unused lane is never hit
+      parallel_chunks(slots / 4, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t l = begin; l < end; ++l) {
+          for (int j = 0; j < 4; ++j) {
+            const std::uint32_t t = m.bvh.order[4 * l + std::size_t(j)];
+            if (t == Bvh::kNoTriangle) continue;
+            const auto& tri = set.triangles[t];
+            m.tri4[l].set(j, Vec3<T>(set.positions[tri.v[0]]), Vec3<T>(set.positions[tri.v[1]]),
                           Vec3<T>(set.positions[tri.v[2]]));
-      }
+          }
+        }
+      });
+      return;
     }
+    std::vector<unsigned char> pre(slots * m.stride);
+    parallel_chunks(slots, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t s = begin; s < end; ++s) {
+        if (m.bvh.order[s] != Bvh::kNoTriangle)
+          std::memcpy(pre.data() + s * m.stride, m.pre.data() + std::size_t(m.bvh.order[s]) * m.stride, m.stride);
+        else
+          std::memset(pre.data() + s * m.stride, 0, m.stride);
+      }
+    });
+    m.pre = std::move(pre);
   }
 
   template <class T>

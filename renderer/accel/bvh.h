@@ -1,10 +1,12 @@
 // An 8-wide bounding volume hierarchy over one mesh's triangles, the modern
 // reference next to document 002's optimisations (backface culling, the
 // bounding sphere in bounding_sphere.h). Sources: binned SAH (Wald 2007, "On
-// fast construction of SAH-based BVHs"), collapsed to 8 children per node
-// (Dammertz et al. 2008, "Shallow bounding volume hierarchies"; Embree's
-// BVH8), and boxes tested 8 at a time in float with the rounding made
-// conservative (Ize 2013, "Robust BVH Ray Traversal"; Embree's robust mode).
+// fast construction of SAH-based BVHs"), 8 children per node (Dammertz et
+// al. 2008, "Shallow bounding volume hierarchies"; built directly as
+// Embree's BVH8 builder does: the child with the largest box split next; on
+// all threads, the tree the same for every thread count; bvh.cpp), and
+// boxes tested 8 at a time in float with the rounding made conservative
+// (Ize 2013, "Robust BVH Ray Traversal"; Embree's robust mode).
 //
 // Guarantee: every leaf whose padded box the exact ray segment [tmin, tmax]
 // meets is visited, so a hit the triangle kernel reports (inside its triangle
@@ -37,6 +39,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <type_traits>
 #include <vector>
@@ -75,9 +78,14 @@ struct Bvh {
   }
 
   // Builds over triangles given by their boxes; `pad` widens every box.
-  // Uses up to `threads` threads (0: all cores); the tree does not depend
-  // on the thread count.
+  // Uses up to `threads` threads (0: all cores); the tree (nodes and order,
+  // byte for byte) does not depend on the thread count.
   static Bvh build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, double pad, int threads = 0);
+  // The same with triangles [begin, end)'s boxes written by `boxes` to
+  // lo[0 .. end - begin) and hi[...] on the build's threads, a piece at a
+  // time (no array of all the boxes).
+  using BoxFn = std::function<void(std::size_t begin, std::size_t end, Vec3d* lo, Vec3d* hi)>;
+  static Bvh build(std::size_t n, const BoxFn& boxes, double pad, int threads = 0);
 };
 
 namespace bvh_detail {

@@ -2,7 +2,9 @@
 // triangles (--accel none) does, on the rays where a float box test is most
 // likely to go wrong: origins far from the mesh, on its box planes, inside
 // it, axis-parallel directions, tiny and huge |d|, windows ending at a hit
-// or starting behind the origin (the two-sided slack of meet8).
+// or starting behind the origin (the two-sided slack of meet8). And the
+// build's structure: the same tree for every thread count, every triangle
+// in one leaf, every box holding what is below it.
 #include "accel/bvh.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +14,7 @@
 #include <cstring>
 
 #include <memory>
+#include <cstring>
 #include <random>
 
 #include "render.h"
@@ -176,6 +179,123 @@ TEST(Bvh, FusedBoxTestNeverRejectsABoxTheSegmentMeets) {
   }
   EXPECT_GT(rays, 15000);
   EXPECT_GT(met, 40000);
+}
+
+// Boxes of `n` random small triangles; `clumps` > 0 puts them on that many
+// points only (coinciding centroids: the build's halving fallback).
+void random_boxes(int n, int clumps, std::uint64_t seed, std::vector<Vec3d>& lo, std::vector<Vec3d>& hi) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-10, 10), s(0, 0.3);
+  std::vector<Vec3d> points;
+  for (int i = 0; i < clumps; ++i) points.push_back({u(rng), u(rng), u(rng)});
+  lo.clear();
+  hi.clear();
+  for (int i = 0; i < n; ++i) {
+    const Vec3d c = clumps > 0 ? points[std::size_t(i % clumps)] : Vec3d{u(rng), u(rng), u(rng)};
+    const Vec3d e = clumps > 0 ? Vec3d{0.1, 0.1, 0.1} : Vec3d{s(rng), s(rng), s(rng)};
+    lo.push_back(c - e);
+    hi.push_back(c + e);
+  }
+}
+
+bool same_tree(const Bvh& a, const Bvh& b) {
+  return a.nodes.size() == b.nodes.size() && a.order == b.order &&
+         std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)) == 0;
+}
+
+// Walks the tree from the root: every node reached once, every triangle in
+// exactly one leaf, each child's box holding the boxes below it (a leaf's
+// triangles, or every box of its node), no leaf deeper than the traversal
+// stack allows. Returns the number of nodes reached.
+std::size_t check_structure(const Bvh& b, const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi) {
+  std::vector<int> seen(lo.size(), 0), reached(b.nodes.size(), 0);
+  std::size_t nodes = 0;
+  struct Item {
+    std::uint32_t node;
+    int depth;
+  };
+  std::vector<Item> todo{{0, 1}};
+  while (!todo.empty()) {
+    const Item it = todo.back();
+    todo.pop_back();
+    EXPECT_LT(it.node, b.nodes.size());
+    if (it.node >= b.nodes.size() || reached[it.node]++) {
+      ADD_FAILURE() << "node " << it.node << " reached twice or out of range";
+      continue;
+    }
+    ++nodes;
+    EXPECT_LE(it.depth, Bvh::kMaxDepth);
+    const BvhNode& n = b.nodes[it.node];
+    int used = 0;
+    for (int i = 0; i < Bvh::kWidth; ++i) {
+      const std::uint32_t c = n.child[i];
+      if (c == Bvh::kEmpty) continue;
+      ++used;
+      if (Bvh::is_leaf(c)) {
+        const unsigned first = Bvh::leaf_first(c), count = Bvh::leaf_count(c);
+        EXPECT_LE(count, unsigned(Bvh::kMaxLeaf));
+        for (unsigned s = first; s < first + 4; ++s) {
+          if (s >= first + count) {
+            EXPECT_EQ(b.order[s], Bvh::kNoTriangle);
+            continue;
+          }
+          ++seen[b.order[s]];
+          for (int a = 0; a < 3; ++a) {
+            EXPECT_LE(n.lo[a][i], lo[b.order[s]][a]);
+            EXPECT_GE(n.hi[a][i], hi[b.order[s]][a]);
+          }
+        }
+        continue;
+      }
+      const BvhNode& k = b.nodes[c];
+      for (int j = 0; j < Bvh::kWidth; ++j) {
+        if (k.child[j] == Bvh::kEmpty) continue;
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_LE(n.lo[a][i], k.lo[a][j]);
+          EXPECT_GE(n.hi[a][i], k.hi[a][j]);
+        }
+      }
+      todo.push_back({c, it.depth + 1});
+    }
+    EXPECT_GE(used, 1);
+  }
+  for (std::size_t t = 0; t < seen.size(); ++t) EXPECT_EQ(seen[t], 1) << "triangle " << t;
+  EXPECT_EQ(nodes, b.nodes.size());
+  return nodes;
+}
+
+// Large enough for the splits spread over threads and the subtree tasks.
+TEST(BvhBuild, SameTreeForEveryThreadCountAndEveryTriangleOnce) {
+  std::vector<Vec3d> lo, hi;
+  random_boxes(100000, 0, 7, lo, hi);
+  const Bvh one = Bvh::build(lo, hi, 1e-6, 1);
+  EXPECT_GT(check_structure(one, lo, hi), 100000u / 32);
+  for (int t : {2, 7}) {
+    const Bvh many = Bvh::build(lo, hi, 1e-6, t);
+    EXPECT_TRUE(same_tree(one, many)) << t << " threads";
+  }
+}
+
+// Coinciding centroids give SAH nothing to split: the build halves instead.
+TEST(BvhBuild, CoincidingCentroidsAreHalved) {
+  std::vector<Vec3d> lo, hi;
+  random_boxes(50000, 3, 8, lo, hi);
+  const Bvh one = Bvh::build(lo, hi, 0, 1);
+  check_structure(one, lo, hi);
+  EXPECT_TRUE(same_tree(one, Bvh::build(lo, hi, 0, 2)));
+}
+
+TEST(BvhBuild, TinyMeshes) {
+  for (int n : {0, 1, 4, 5, 9, 33}) {
+    std::vector<Vec3d> lo, hi;
+    random_boxes(n, 0, 9, lo, hi);
+    const Bvh b = Bvh::build(lo, hi, 0, 2);
+    if (n == 0) {
+      EXPECT_TRUE(b.nodes.empty());
+      continue;
+    }
+    check_structure(b, lo, hi);
+  }
 }
 
 }  // namespace
