@@ -817,7 +817,13 @@ struct ChunkParser {
   void grow_triangles() {
     auto& v = m.triangles;
     const double done = double(here - c.begin + 1), total = double(c.end - c.begin);
-    const size_t guess = size_t(double(v.size()) * (total / done) * 1.05) + 64;
+    // Never more than the rest of the file can hold: every further triangle
+    // needs a corner of at least 2 bytes ("1 "). Inside one long face the
+    // bytes read so far are few, and the extrapolation alone asked for
+    // terabytes (a 2 MB face of 1M corners: std::bad_alloc, issue 15).
+    const size_t most = v.size() + size_t(c.end - here) / 2 + 64;
+    const double estimate = double(v.size()) * (total / done) * 1.05 + 64;
+    const size_t guess = estimate < double(most) ? size_t(estimate) : most;
     v.reserve(std::max(guess, v.size() + v.size() / 2 + 64));
     advise_huge(v);
   }

@@ -283,6 +283,29 @@ TEST(Triangulate, OverflowingExtentsStillGiveNMinus2Triangles) {
     for (int k : t) EXPECT_TRUE(k >= 0 && k < int(p.size()));
 }
 
+// A 2 MB face of a million corners (all one vertex): the triangle array's
+// growth extrapolated from the few bytes read before the face and asked
+// for terabytes (std::bad_alloc naming no file). Now bounded by what the
+// rest of the file can hold; the face loads, with the work-limit warning.
+TEST(Triangulate, FaceOfAMillionCornersLoadsWithAWarning) {
+  std::string text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+  for (int i = 0; i < 1000000; ++i) text += " 1";
+  text += "\n";
+  const Mesh m = parse_obj(text, "million.obj");
+  EXPECT_EQ(m.triangles.size(), 999998u);
+  EXPECT_LT(m.triangles.capacity(), 2000000u) << "reserved far beyond what the file holds";
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_EQ(m.warnings[0].rfind("million.obj:4: polygon of 1000000 corners", 0), 0u) << m.warnings[0];
+}
+
+// Messages quote bad input: control bytes and bytes that are not UTF-8
+// come out as \xNN, so the message stays one printable line.
+TEST(Located, ControlAndNonUtf8BytesAreEscaped) {
+  EXPECT_EQ(located("f.ply", 9, std::string("malformed PLY value '") + '\0' + "'"), "f.ply:9: malformed PLY value '\\x00'");
+  EXPECT_EQ(located("a\nb", 0, "x\ry\xff\xfez"), "a\\x0ab: x\\x0dy\\xff\\xfez");
+  EXPECT_EQ(located("f", 1, "caf\xc3\xa9 \xe2\x82\xac"), "f:1: caf\xc3\xa9 \xe2\x82\xac");  // UTF-8 kept
+}
+
 // A concave polygon still tiles exactly (a U: 8 corners, area 5).
 TEST(Triangulate, ConcaveUStillTilesExactly) {
   const std::vector<Vec3d> p = {{0, 0, 0}, {3, 0, 0}, {3, 2, 0}, {2, 2, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
