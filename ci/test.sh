@@ -1,8 +1,19 @@
 #!/usr/bin/env bash
 # Command 2 of the README (and what .ci/run runs): install what is missing,
 # build, fetch the mesh corpus into the cache, run the whole test suite
-# through ctest, then a 30-second libFuzzer run per parser. Idempotent.
+# through ctest, again on the asan preset (ASan + UBSan; ci/asan.sh), then a
+# 30-second libFuzzer run per parser. Idempotent. Each stage prints its wall
+# and CPU time (the budget: 30 minutes on 2 cores).
+build_start=$SECONDS
 source "$(dirname "$0")/common.sh"
+echo "== stage install+build: $((SECONDS - build_start)) s wall"
+# Runs "$@" as one timed stage: wall, user and sys seconds (children included).
+timed() {
+  local name="$1"
+  shift
+  local TIMEFORMAT="== stage $name: %0R s wall, %0U s user, %0S s sys"
+  time "$@"
+}
 
 # In CI (CI set) the corpus is fetched into a new, empty cache on every run,
 # as a newcomer's machine has it: a missing or broken fetch step fails here
@@ -15,10 +26,14 @@ if [ -n "${CI:-}" ]; then
 fi
 
 step "fetching the mesh corpus into ${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus (ci/fetch-corpus.sh)"
-ci/fetch-corpus.sh "$RAYAUDIT"
+timed corpus ci/fetch-corpus.sh "$RAYAUDIT"
 
 step "running the test suite (ctest --preset release)"
-ctest --preset release -j "$JOBS"
+timed ctest ctest --preset release -j "$JOBS"
+
+step "the same suite under ASan + UBSan (ci/asan.sh: asan preset build, ctest; pov label sampled)"
+timed asan ci/asan.sh
 
 step "fuzzing every parser (OBJ, MTL, PLY, OFF, scene JSON, cases CSV, tolerance JSON) for ${FUZZ_SECONDS:-30} s each (ci/fuzz.sh)"
-ci/fuzz.sh
+timed fuzz ci/fuzz.sh
+echo "== total: $SECONDS s wall"

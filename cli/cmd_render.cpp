@@ -5,6 +5,7 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "image_module.h"
 #include "registry.h"
 #include "render.h"
 #include "scene/scene.h"
@@ -82,6 +83,8 @@ void run(const Args& a) {
       throw ra::InputError(a.out + ": output must be .png or .exr");
     // Its directory too: a missing one used to be found after the render.
     ra::check_output_path(a.out);
+    // And the image module that will write it (loaded now, not after the render).
+    ra::image_module::api();
   }
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;

@@ -1,6 +1,7 @@
 // rayaudit: one program, several subcommands (each in its own cmd_*.cpp).
 // Exit codes: 0 ok, 1 a check failed, 2 bad input or usage.
 #include <algorithm>
+#include <filesystem>
 #include <iostream>
 #include <string_view>
 
@@ -54,6 +55,13 @@ int main(int argc, char** argv) {
   } catch (const ra::CheckFailed& e) {
     std::cerr << e.what() << "\n";
     return 1;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the checks before did not see (a symlink loop met by exists(),
+    // a directory without permission): "PATH: the system's reason", as
+    // every other input error, not the library's "filesystem error: status: ...".
+    const std::string path = !e.path1().empty() ? e.path1().string() : "rayaudit";
+    std::cerr << path << ": " << e.code().message() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     // Anything else (a filesystem error, an allocation too large for this
     // machine) is still about this input: the contract has 0, 1 and 2 only.

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "io/full_disk.h"
 #include "run_rayaudit.h"
@@ -229,6 +230,24 @@ TEST(ReliabilityCli, TextureTooLargeForMemoryNamesTheFile) {
   EXPECT_TRUE(one_line(r.err)) << r.err;
   EXPECT_EQ(r.err.rfind(tex + ": ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("not enough memory"), std::string::npos) << r.err;
+}
+
+// An existing output that is not a regular file is refused before any work:
+// the renamed temporary would have replaced it (run as root, `--json
+// /dev/full` turned the device into a file). A FIFO stands in for a device.
+TEST(ReliabilityCli, OutputThatIsAFifoIsRefusedNotReplaced) {
+  const fs::path fifo = scratch("out-fifo.png");
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  for (const std::string& args : std::vector<std::string>{
+           "render " + kScenes + "/doc000-pyramid.json --width 8 --height 8 -o " + fifo.string(),
+           "audit --rays 100 --families edge --json " + fifo.string()}) {
+    const auto r = run_rayaudit(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
+    EXPECT_EQ(r.err, fifo.string() + ": is a FIFO, not a file: not replaced\n") << args;
+    EXPECT_TRUE(fs::is_fifo(fifo)) << "replaced by " << args;
+  }
+  fs::remove(fifo);
 }
 
 }  // namespace

@@ -21,6 +21,10 @@ set_target_properties(rayaudit_renderer PROPERTIES EXPORT_NAME renderer)
 set_target_properties(rayaudit_validation PROPERTIES EXPORT_NAME validation)
 
 install(TARGETS rayaudit RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The image module (renderer/image_module.h): bin/rayaudit finds it as
+# ../LIBDIR/rayaudit/rayaudit_image.so; programs linking the package get that
+# directory in their RUNPATH from rayauditConfig.cmake.
+install(TARGETS rayaudit_image LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/rayaudit)
 install(TARGETS rayaudit_renderer rayaudit_validation EXPORT rayauditTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})

@@ -2,18 +2,17 @@
 
 #include <unistd.h>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <new>
 #include <string>
 
 #include "io/atomic_file.h"
 #include "errors.h"
+#include "image_module.h"
 #include "io/input_file.h"
 
 namespace ra {
@@ -41,17 +40,11 @@ std::vector<unsigned char> encode_png(const Image& img, const ImageWriteOptions&
     if (eight) px8[i] = std::uint8_t(q);
     else px16[i] = std::uint16_t(q);
   }
-  const OIIO::TypeDesc type = eight ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16;
-  OIIO::ImageSpec spec(img.width, img.height, 3, type);
-  spec.attribute("oiio:ColorSpace", opt.srgb ? "sRGB" : "Linear");
   std::vector<unsigned char> bytes;
-  OIIO::Filesystem::IOVecOutput proxy(bytes);
-  const std::string name = "memory.png";
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out) throw InputError(located(path.string(), 0, "cannot create: " + OIIO::geterror()));
-  if (!out->set_ioproxy(&proxy) || !out->open(name, spec) ||
-      !out->write_image(type, eight ? static_cast<const void*>(px8.data()) : px16.data()) || !out->close())
-    throw InputError(located(path.string(), 0, "cannot encode PNG: " + out->geterror()));
+  std::string err;
+  const void* px = eight ? static_cast<const void*>(px8.data()) : px16.data();
+  if (!image_module::api().encode_png(img.width, img.height, opt.bits, px, opt.srgb ? "sRGB" : "Linear", &bytes, &err))
+    throw InputError(located(path.string(), 0, "cannot encode PNG: " + err));
   return bytes;
 }
 
@@ -66,14 +59,9 @@ void write_image(const std::filesystem::path& path, const Image& img, const Imag
     throw InputError(located(path.string(), 0, "PNG bits must be 8 or 16"));
   write_atomically(path, [&](const std::filesystem::path& tmp) {
     if (ext == ".exr") {
-      auto out = OIIO::ImageOutput::create(tmp.string());
-      if (!out) throw InputError(located(path.string(), 0, "cannot create: " + OIIO::geterror()));
-      OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
-      if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, img.rgb.data()))
-        throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
-      // close() flushes: a failure here (disk full) must not rename a
-      // truncated file into place.
-      if (!out->close()) throw InputError(located(path.string(), 0, "cannot write: " + out->geterror()));
+      std::string err;
+      if (!image_module::api().write_exr(tmp.c_str(), img.width, img.height, img.rgb.data(), &err))
+        throw InputError(located(path.string(), 0, err));
       return;
     }
     // OIIO's PNG writer does not report a failed write (full disk: exit 0
@@ -112,12 +100,6 @@ class QuietStderr {
   int saved_ = -1;
 };
 
-// The first line of an OIIO error text (they can run to several).
-std::string first_line(std::string s) {
-  const auto nl = s.find('\n');
-  if (nl != std::string::npos) s.resize(nl);
-  return s.empty() ? "unreadable or unsupported image" : s;
-}
 
 }  // namespace
 
@@ -127,15 +109,17 @@ std::vector<float> read_pixels(const std::filesystem::path& path, const char* wh
   std::error_code ec;
   const std::uint64_t bytes = std::filesystem::file_size(path, ec);
   const std::string name = path.string();
+  const image_module::Api& oiio = image_module::api();
   QuietStderr quiet;
-  auto in = OIIO::ImageInput::open(name);
-  if (!in) throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + first_line(OIIO::geterror())));
-  const OIIO::ImageSpec& spec = in->spec();
+  image_module::Header spec;
+  std::string err;
+  const std::unique_ptr<void, void (*)(void*)> in(oiio.open(name.c_str(), &spec, &err), oiio.close);
+  if (!in) throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + err));
   const std::uint64_t w = std::uint64_t(std::max(spec.width, 0)), h = std::uint64_t(std::max(spec.height, 0));
   const std::string dims = std::to_string(w) + "x" + std::to_string(h);
-  if (w == 0 || h == 0 || spec.nchannels < 1 || spec.nchannels > 64)
+  if (w == 0 || h == 0 || spec.channels < 1 || spec.channels > 64)
     throw InputError(located(name, 0, what + std::string(" header declares ") + dims + " with " +
-                                          std::to_string(spec.nchannels) + " channels"));
+                                          std::to_string(spec.channels) + " channels"));
   // The header's size is trusted only as far as the file can hold it: at
   // most kMaxPixelsPerByte pixels a byte, and never beyond the render limit.
   if (w > kMaxImageSide || h > kMaxImageSide)
@@ -146,7 +130,7 @@ std::vector<float> read_pixels(const std::filesystem::path& path, const char* wh
                                           std::to_string(bytes) + " bytes can hold (the file is truncated or corrupt)"));
   width = int(w);
   height = int(h);
-  channels = spec.nchannels;
+  channels = spec.channels;
   std::vector<float> all;
   try {
     all.resize(std::size_t(w * h) * std::size_t(channels));
@@ -155,9 +139,8 @@ std::vector<float> read_pixels(const std::filesystem::path& path, const char* wh
                                           std::to_string(w * h * std::uint64_t(channels) * 4 >> 20) +
                                           " MB to read: not enough memory"));
   }
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + first_line(in->geterror())));
-  in->close();
+  if (!oiio.read(in.get(), channels, all.data(), &err))
+    throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + err));
   return all;
 }
 

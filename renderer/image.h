@@ -1,5 +1,6 @@
-// Linear float RGB images and their files, through OpenImageIO: PNG 8 or 16
-// bits per channel (linear values unless sRGB is asked for), EXR float.
+// Linear float RGB images and their files, through OpenImageIO (loaded on
+// first use: image_module.h): PNG 8 or 16 bits per channel (linear values
+// unless sRGB is asked for), EXR float.
 #pragma once
 #include <cstdint>
 #include <filesystem>

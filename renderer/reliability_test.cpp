@@ -15,6 +15,7 @@
 #include "image.h"
 #include "io/input_file.h"
 #include "io/json_input.h"
+#include "formats/mesh.h"
 #include "formats/triangulate.h"
 #include "workers.h"
 
@@ -196,7 +197,7 @@ TEST(Triangulate, ConvexPolygonOf300kCornersIsAFan) {
   }
   std::vector<std::array<int, 3>> out;
   EarClipScratch s;
-  triangulate_polygon(p.data(), n, out, s);
+  EXPECT_FALSE(triangulate_polygon(p.data(), n, out, s)) << "a convex polygon is within the work limit";
   ASSERT_EQ(out.size(), size_t(n - 2));
   for (int i = 0; i < n - 2; ++i) EXPECT_EQ(out[size_t(i)], (std::array<int, 3>{0, i + 1, i + 2})) << i;
   // Area of the regular n-gon of radius 1: n/2 sin(2 pi / n).
@@ -215,10 +216,47 @@ TEST(Triangulate, SpikyPolygonOf200kCornersKeepsItsCount) {
   }
   std::vector<std::array<int, 3>> out;
   EarClipScratch s;
-  triangulate_polygon(p.data(), n, out, s);
+  EXPECT_TRUE(triangulate_polygon(p.data(), n, out, s)) << "the work limit was spent: the caller must know";
   EXPECT_EQ(out.size(), size_t(n - 2));
   for (const auto& t : out)
     for (int k : t) ASSERT_TRUE(k >= 0 && k < n);
+}
+
+// A star of n corners (every other one reflex) as one OBJ face on line 2+n.
+std::string star_obj(int n, int faces) {
+  std::string text = "# star\n";
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n, r = i % 2 ? 0.5 : 1.0;
+    text += "v " + std::to_string(r * std::cos(t)) + " " + std::to_string(r * std::sin(t)) + " 0\n";
+  }
+  for (int f = 0; f < faces; ++f) {
+    text += "f";
+    for (int i = 1; i <= n; ++i) text += " " + std::to_string(i);
+    text += "\n";
+  }
+  return text;
+}
+
+// The cut is no longer silent: one warning naming the first such face's
+// line, its corner count and how many faces were cut, serial or parallel.
+TEST(Triangulate, PolygonBeyondTheWorkLimitIsOneWarningNamingItsLine) {
+  const int n = 20000;
+  const std::string text = star_obj(n, 3);
+  for (int threads : {1, 2}) {
+    ObjOptions opt;
+    opt.threads = threads;
+    opt.parallel_min_bytes = 0;
+    const Mesh m = parse_obj(text, "star.obj", opt);
+    EXPECT_EQ(m.triangles.size(), size_t(3 * (n - 2)));
+    ASSERT_EQ(m.warnings.size(), 1u) << threads;
+    EXPECT_EQ(m.warnings[0].rfind("star.obj:" + std::to_string(n + 2) + ": polygon of 20000 corners ", 0), 0u)
+        << m.warnings[0];
+    EXPECT_NE(m.warnings[0].find("(3 polygons)"), std::string::npos) << m.warnings[0];
+  }
+  // A concave polygon within the limit: no warning.
+  const Mesh u = parse_obj("v 0 0 0\nv 3 0 0\nv 3 2 0\nv 2 2 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6 7 8\n", "u.obj");
+  EXPECT_EQ(u.triangles.size(), 6u);
+  EXPECT_TRUE(u.warnings.empty());
 }
 
 // 60k collinear corners (degenerate: no ear at all) took 6.5 s.
@@ -245,12 +283,35 @@ TEST(Triangulate, OverflowingExtentsStillGiveNMinus2Triangles) {
     for (int k : t) EXPECT_TRUE(k >= 0 && k < int(p.size()));
 }
 
+// A 2 MB face of a million corners (all one vertex): the triangle array's
+// growth extrapolated from the few bytes read before the face and asked
+// for terabytes (std::bad_alloc naming no file). Now bounded by what the
+// rest of the file can hold; the face loads, with the work-limit warning.
+TEST(Triangulate, FaceOfAMillionCornersLoadsWithAWarning) {
+  std::string text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+  for (int i = 0; i < 1000000; ++i) text += " 1";
+  text += "\n";
+  const Mesh m = parse_obj(text, "million.obj");
+  EXPECT_EQ(m.triangles.size(), 999998u);
+  EXPECT_LT(m.triangles.capacity(), 2000000u) << "reserved far beyond what the file holds";
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_EQ(m.warnings[0].rfind("million.obj:4: polygon of 1000000 corners", 0), 0u) << m.warnings[0];
+}
+
+// Messages quote bad input: control bytes and bytes that are not UTF-8
+// come out as \xNN, so the message stays one printable line.
+TEST(Located, ControlAndNonUtf8BytesAreEscaped) {
+  EXPECT_EQ(located("f.ply", 9, std::string("malformed PLY value '") + '\0' + "'"), "f.ply:9: malformed PLY value '\\x00'");
+  EXPECT_EQ(located("a\nb", 0, "x\ry\xff\xfez"), "a\\x0ab: x\\x0dy\\xff\\xfez");
+  EXPECT_EQ(located("f", 1, "caf\xc3\xa9 \xe2\x82\xac"), "f:1: caf\xc3\xa9 \xe2\x82\xac");  // UTF-8 kept
+}
+
 // A concave polygon still tiles exactly (a U: 8 corners, area 5).
 TEST(Triangulate, ConcaveUStillTilesExactly) {
   const std::vector<Vec3d> p = {{0, 0, 0}, {3, 0, 0}, {3, 2, 0}, {2, 2, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
   std::vector<std::array<int, 3>> out;
   EarClipScratch s;
-  triangulate_polygon(p.data(), 8, out, s);
+  EXPECT_FALSE(triangulate_polygon(p.data(), 8, out, s));
   ASSERT_EQ(out.size(), 6u);
   for (const auto& t : out) EXPECT_GT(area2d(p, {t}), 0) << t[0] << " " << t[1] << " " << t[2];
   EXPECT_DOUBLE_EQ(area2d(p, out), 5.0);

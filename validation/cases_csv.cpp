@@ -116,10 +116,17 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
       throw InputError(located(path, lineno, "expected " + std::to_string(header.size()) +
                                                  " fields as in the header, found " + std::to_string(f.size())));
     double v[15];
-    for (int k = 0; k < 15; ++k)
-      if (!parse_double(f[std::size_t(col[k])], v[k]))
-        throw InputError(located(path, lineno, std::string("column '") + kColumns[k] + "': '" +
-                                                   f[std::size_t(col[k])] + "' is not a number"));
+    for (int k = 0; k < 15; ++k) {
+      const bool number = parse_double(f[std::size_t(col[k])], v[k]);
+      if (!number || !std::isfinite(v[k])) {
+        // A NaN or infinite coordinate was accepted and judged; a 2 MB
+        // number was quoted whole (issue 15's second pass).
+        const std::string& t = f[std::size_t(col[k])];
+        const std::string shown = t.size() > 40 ? t.substr(0, 40) + "... (" + std::to_string(t.size()) + " bytes)" : t;
+        throw InputError(located(path, lineno, std::string("column '") + kColumns[k] + "': '" + shown +
+                                                   (number ? "' is not a finite number" : "' is not a number")));
+      }
+    }
     UserCase c;
     c.id_is_row = id_col < 0;
     c.id = id_col < 0 ? std::to_string(row) : f[std::size_t(id_col)];

@@ -110,6 +110,30 @@ GoldenEntry entry_from(const json& j) {
   return e;
 }
 
+// A relative path that stays under the root: no "..", not absolute, not empty.
+bool inside_root(const std::string& p) {
+  const fs::path path(p);
+  if (p.empty() || path.is_absolute()) return false;
+  for (const auto& part : path)
+    if (part == "..") return false;
+  return true;
+}
+
+// What the manifest's values must be before anything is rendered or
+// written (a width of -8 was "cannot create std::vector larger than
+// max_size()", 100000 a bare bad_alloc; a name of "../x" put the diff image
+// outside --diff-dir: issue 15's second pass).
+std::string entry_problem(const GoldenEntry& e) {
+  if (!inside_root(e.name)) return "name \"" + e.name + "\" must be a relative path without \"..\"";
+  if (!inside_root(e.scene)) return "scene \"" + e.scene + "\" must be a relative path under the root without \"..\"";
+  if (!inside_root(e.image)) return "image \"" + e.image + "\" must be a relative path under the root without \"..\"";
+  if (e.width < 1 || e.height < 1 || e.width > int(kMaxImageSide) || e.height > int(kMaxImageSide))
+    return "size " + std::to_string(e.width) + "x" + std::to_string(e.height) + " is not 1 to " +
+           std::to_string(kMaxImageSide) + " pixels a side";
+  if (e.bits != 8 && e.bits != 16) return "bits must be 8 or 16, got " + std::to_string(e.bits);
+  return "";
+}
+
 // Which inputs differ between what was blessed and what is there now.
 std::string changed_inputs(const std::map<std::string, std::string>& then,
                            const std::map<std::string, std::string>& now) {
@@ -195,6 +219,7 @@ GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
       } catch (const json::exception& e) {
         throw InputError(at + ": " + json_error_text(e));
       }
+      if (const std::string why = entry_problem(g); !why.empty()) throw InputError(at + ": " + why);
       if (entries_.count(g.name)) throw InputError(at + ": golden \"" + g.name + "\" listed twice");
       entries_[g.name] = g;
     }

@@ -1,24 +1,15 @@
 #include "image_compare.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-
 #include <cmath>
 #include <cstdio>
 
 #include "errors.h"
+#include "image_module.h"
 
 namespace ra {
 namespace {
 
 unsigned max_level(int bits) { return bits == 16 ? 65535u : 255u; }
-
-OIIO::ImageBuf to_buf(const Image& img) {
-  OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf buf(spec);
-  buf.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, img.rgb.data());
-  return buf;
-}
 
 // The threshold for "more than k/255": half a level of `bits` above k/255.
 float threshold(int k, int bits) {
@@ -48,15 +39,15 @@ ImageComparison compare_images(const Image& ours, const Image& theirs, int bits)
   c.pixels = long(a.width) * a.height;
   // compare() also sets the error flag whenever nfail > 0, so its has_error()
   // is not a failure of the comparison itself (../shared/POVRAY.md).
-  const OIIO::ImageBuf A = to_buf(a), B = to_buf(b);
-  const auto r = OIIO::ImageBufAlgo::compare(A, B, threshold(4, bits), threshold(1, bits));
-  c.mean_error = r.meanerror;
+  image_module::CompareStats r;
+  image_module::api().compare(a.width, a.height, a.rgb.data(), b.rgb.data(), threshold(4, bits), threshold(1, bits), &r);
+  c.mean_error = r.mean_error;
   c.rms_error = r.rms_error;
-  c.psnr = r.PSNR;
-  c.max_error = r.maxerror;
-  c.max_x = r.maxx;
-  c.max_y = r.maxy;
-  c.max_channel = r.maxc;
+  c.psnr = r.psnr;
+  c.max_error = r.max_error;
+  c.max_x = r.max_x;
+  c.max_y = r.max_y;
+  c.max_channel = r.max_channel;
   // OIIO 2.4 counts a pixel over both thresholds in nwarn and in nfail.
   c.over_4 = long(r.nfail);
   c.over_1 = long(r.nwarn);
@@ -76,11 +67,10 @@ ImageComparison compare_images(const Image& ours, const Image& theirs, int bits)
 
 Image difference_image(const Image& ours, const Image& theirs, int bits) {
   const Image a = quantized(ours, bits), b = quantized(theirs, bits);
-  OIIO::ImageBuf diff = OIIO::ImageBufAlgo::absdiff(to_buf(a), to_buf(b));
   const double m = max_level(bits);
   Image out(a.width, a.height);
   std::vector<float> d(a.rgb.size());
-  diff.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, d.data());
+  image_module::api().absdiff(a.width, a.height, a.rgb.data(), b.rgb.data(), d.data());
   for (int y = 0; y < a.height; ++y)
     for (int x = 0; x < a.width; ++x) {
       const std::size_t i = (std::size_t(y) * a.width + x) * 3;

@@ -73,6 +73,15 @@ TEST_F(PackageConsumer, InstalledPackageBuildsAUsersProjectAndItsTestReportsTheL
   EXPECT_TRUE(fs::exists(prefix / "include/rayaudit/audit.h"));
   EXPECT_TRUE(fs::exists(prefix / "include/rayaudit/audit_gtest.h"));
   EXPECT_FALSE(fs::exists(prefix / "include/audit.h"));
+  // The image module (OpenImageIO, loaded on first use) is installed, and the
+  // installed rayaudit finds it from bin/: it writes a PNG.
+  ASSERT_TRUE(fs::exists(prefix / "lib/rayaudit/rayaudit_image.so"));
+  const fs::path png = dir_ / "installed.png";
+  const ShellResult render = sh(quoted(prefix / "bin/rayaudit") + " render " +
+                                quoted(fs::path(RAYAUDIT_SOURCE_DIR) / "scenes/doc000-pyramid.json") +
+                                " --width 16 --height 12 -o " + quoted(png));
+  ASSERT_EQ(render.code, 0) << render.out;
+  EXPECT_GT(fs::file_size(png), 50u);
 
   const ShellResult configure = sh(cmake + " -S " + quoted(fs::path(RAYAUDIT_SOURCE_DIR) / "validation/consumer") +
                            " -B " + quoted(build) + " -G Ninja -DCMAKE_BUILD_TYPE=Release" +
@@ -80,6 +89,10 @@ TEST_F(PackageConsumer, InstalledPackageBuildsAUsersProjectAndItsTestReportsTheL
   ASSERT_EQ(configure.code, 0) << configure.out;
   const ShellResult compile = sh(cmake + " --build " + quoted(build));
   ASSERT_EQ(compile.code, 0) << compile.out;
+
+  // A program linking the package finds the module through its RUNPATH.
+  const ShellResult dynamic = sh("readelf -d " + quoted(build / "my_intersector_test"));
+  EXPECT_NE(dynamic.out.find((prefix / "lib/rayaudit").string()), std::string::npos) << dynamic.out;
 
   const ShellResult test = sh(quoted(build / "my_intersector_test"));
   // The textbook method is not watertight: the user's test must fail, and say so.

@@ -1,10 +1,5 @@
 #include "pov_export.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include <charconv>
 #include <cmath>
 #include <map>
@@ -12,6 +7,7 @@
 
 #include "io/atomic_file.h"
 #include "errors.h"
+#include "image_module.h"
 
 namespace ra {
 namespace {
@@ -250,22 +246,15 @@ PovExport export_pov(const Scene& scene, const std::string& image_prefix) {
 }
 
 void copy_pov_image(const std::filesystem::path& source, const std::filesystem::path& dest) {
-  OIIO::ImageBuf in(source.string());
-  if (!in.read(0, 0, true)) throw InputError(located(source.string(), 0, "cannot read image: " + in.geterror()));
-  const int nch = in.spec().nchannels;
-  // RGB without alpha; a grey image becomes three equal channels.
-  const int channels[3] = {0, nch >= 3 ? 1 : 0, nch >= 3 ? 2 : 0};
-  OIIO::ImageBuf rgb3 = OIIO::ImageBufAlgo::channels(in, 3, channels);
-  const bool eight = in.spec().format == OIIO::TypeDesc::UINT8;
   // Encoded in memory, then written with every write and close checked:
   // OIIO's PNG writer does not report a full disk (issue 15).
-  OIIO::ImageSpec spec = rgb3.spec();
-  spec.set_format(eight ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
   std::vector<unsigned char> png;
-  OIIO::Filesystem::IOVecOutput proxy(png);
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out || !out->set_ioproxy(&proxy) || !out->open("memory.png", spec) || !rgb3.write(out.get()) || !out->close())
-    throw InputError(located(dest.string(), 0, "cannot encode PNG: " + (out ? out->geterror() : OIIO::geterror())));
+  std::string err;
+  switch (image_module::api().rgb_png(source.c_str(), &png, &err)) {
+    case 0: break;
+    case 1: throw InputError(located(source.string(), 0, "cannot read image: " + err));
+    default: throw InputError(located(dest.string(), 0, "cannot encode PNG: " + err));
+  }
   write_atomically(dest, [&](const std::filesystem::path& tmp) {
     write_bytes_checked(tmp, png.data(), png.size(), dest.string());
   });

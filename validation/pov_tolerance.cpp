@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "errors.h"
+#include "image.h"
 #include "io/json_input.h"
 
 namespace ra {
@@ -30,8 +31,17 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
     if (j.contains("notes") && !j.at("notes").is_string()) throw InputError(file.string() + ": /notes: expected a string");
     if (j.contains("pixels") && !j.at("pixels").is_array()) throw InputError(file.string() + ": /pixels: expected an array");
     t.notes = j.value("notes", "");
-    if (j.contains("width")) t.width = j.at("width").get<int>();
-    if (j.contains("height")) t.height = j.at("height").get<int>();
+    // Sizes and pixel coordinates inside the render limit (a pixel at x -1
+    // was accepted and never matched; 3e9 wrapped round as an int).
+    auto side = [&](const nlohmann::json& v, const std::string& where, long long lo, long long hi) {
+      const long long x = v.get<long long>();
+      if (x < lo || x > hi)
+        throw InputError(where + ": " + std::to_string(x) + " is outside " + std::to_string(lo) + ".." + std::to_string(hi));
+      return int(x);
+    };
+    const long long kSide = (long long)kMaxImageSide;
+    if (j.contains("width")) t.width = side(j.at("width"), file.string() + ": /width", 1, kSide);
+    if (j.contains("height")) t.height = side(j.at("height"), file.string() + ": /height", 1, kSide);
     t.max_levels_16 = j.value("max_levels_16", t.max_levels_16);
     if (t.max_levels_16 < 0 || t.max_levels_16 > 16)
       throw InputError(file.string() + ": /max_levels_16: must be 0..16 (POV's float32 colours give 2)");
@@ -51,6 +61,10 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
         if (!p.contains(k)) throw InputError(at + ": needs \"" + k + "\"");
       if (!p.contains("levels"))
         throw InputError(at + ": needs \"levels\", the largest difference allowed there (8-bit levels)");
+      side(p.at("x"), at + "/x", 0, t.width.value_or(kSide) - 1);
+      side(p.at("y"), at + "/y", 0, t.height.value_or(kSide) - 1);
+      if (const long long l = p.at("levels").get<long long>(); l < 1 || l > 255)
+        throw InputError(at + "/levels: must be 1..255");
       ExplainedPixel e{p.at("x").get<int>(), p.at("y").get<int>(), p.at("levels").get<int>(),
                        p.at("cause").get<std::string>()};
       if (e.levels < 1 || e.levels > 255) throw InputError(at + "/levels: must be 1..255");

@@ -189,3 +189,31 @@ put('texture', 'idat_garbage.png', png(4, 4, b'\x01\x02\x03garbage'))
 put('texture', 'not_an_exr.exr', 'v/1\x01 not really an EXR\n')
 put('texture', 'zero_width.png', png(0, 4, zlib.compress(b'\x00' * 4)))
 put_dir('texture', 'is_a_directory.png')
+
+# ---- second hostile pass (issue 15) ----
+PH = 'ply\nformat ascii 1.0\nelement vertex 3\n'
+put('ply', 'duplicate_property.ply', PH + 'property float x\nproperty float x\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n')
+put('ply', 'list_count_float.ply', PH + 'property float x\nproperty float y\nproperty float z\nelement face 1\nproperty list float int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'nul_in_value.ply', PH + 'property float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 \x00\n0 1 0\n')
+put('off', 'binary_off.off', 'OFF BINARY\n3 1 0\n')
+put('scene', 'mesh_is_ply.json', '{"objects": [{"mesh": "../ply/extra_values.ply"}]}\n')
+put('scene', 'invalid_utf8.json', b'{"objects": [{"mesh": "\xff\xfe.obj"}]}\n')
+HD = 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n'
+put('csv', 'nan_value.csv', HD + 'nan,0.2,1,0,0,-1,0,0,0,1,0,0,0,1,0\n')
+put('csv', 'inf_value.csv', HD + '0.2,0.2,1,0,0,-inf,0,0,0,1,0,0,0,1,0\n')
+put('csv', 'long_number.csv', HD + '1' * 5000 + ',0.2,1,0,0,-1,0,0,0,1,0,0,0,1,0\n')
+put('tolerance', 'pixel_x_negative.json', '{"width": 8, "height": 8, "pixels": [{"x": -1, "y": 0, "levels": 1, "cause": "c"}]}\n')
+put('tolerance', 'pixel_outside_width.json', '{"width": 8, "height": 8, "pixels": [{"x": 8, "y": 0, "levels": 1, "cause": "c"}]}\n')
+put('tolerance', 'width_zero.json', '{"width": 0, "pixels": []}\n')
+GE = '"inputs": {}, "inputs_hash": "fnv1a64:0", '
+put('golden', 'name_traversal.json', '{"goldens": [{' + GE + '"name": "../../evil", "scene": "scenes/a.json", "image": "golden/a.png", "width": 8, "height": 8}]}\n')
+put('golden', 'image_absolute.json', '{"goldens": [{' + GE + '"name": "a", "scene": "scenes/a.json", "image": "/etc/hostname", "width": 8, "height": 8}]}\n')
+put('golden', 'width_negative.json', '{"goldens": [{' + GE + '"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": -8, "height": 8}]}\n')
+put('golden', 'size_huge.json', '{"goldens": [{' + GE + '"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": 100000, "height": 100000}]}\n')
+put('golden', 'bits_12.json', '{"goldens": [{' + GE + '"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": 8, "height": 8, "bits": 12}]}\n')
+put('mtl', 'map_kd_symlink_loop.mtl', 'newmtl a\nmap_Kd ../texture/symlink_loop.png\n')
+put('mtl', 'map_kd_directory.mtl', 'newmtl a\nmap_Kd ../texture/is_a_directory.png\n')
+# A symlink to itself (git keeps it): opening it fails with ELOOP.
+loop = os.path.join(HERE, 'texture', 'symlink_loop.png')
+if not os.path.islink(loop):
+    os.symlink('symlink_loop.png', loop)

@@ -18,6 +18,7 @@
 #include <cstring>
 
 #include "mesh.h"
+#include "input_file.h"
 #include "obj_text.h"
 
 namespace ra {
@@ -125,9 +126,15 @@ struct MtlParser {
     std::filesystem::path path(file);
     if (path.is_relative()) path = (base / path).lexically_normal();
     dst = path.string();
-    std::error_code ec;
-    if (check_files && !std::filesystem::exists(path, ec))
+    // Missing: a warning (the material renders without it). Anything else
+    // that is not a file (a directory, a FIFO, a symlink loop) is an error
+    // here, naming this line, not later as a bare path or a library text.
+    if (!check_files) return;
+    const std::string why = input_file_problem(path);
+    if (why == "no such file")
       warnings.push_back(located(name, line, "texture '" + file + "' not found (" + dst + ")"));
+    else if (!why.empty())
+      w.fail(line, "texture '" + file + "': " + why + " (" + dst + ")");
   }
 
   void statement(const char* p, const char* se, long line) {

@@ -152,9 +152,17 @@ struct Chunk {
   struct Deferred {
     long tri, corner;
     int n;
+    long line;
   };
   std::vector<Deferred> deferred;
   std::vector<Corner> deferred_corners;
+  // polygons whose ear clipping spent its work limit (triangulate.h): how
+  // many, and the first one's line and corner count, for one warning
+  long limited = 0, limited_first_line = 0;
+  int limited_first_n = 0;
+  void note_limited(long line, int n) {
+    if (limited++ == 0 || line < limited_first_line) limited_first_line = line, limited_first_n = n;
+  }
   // step 2 input: chunk-local name ids -> global ones, inherited state
   std::vector<int> mat_map, group_map, object_map;
   int in_mat = -1, in_group = -1, in_object = -1, in_smooth = 0;
@@ -731,7 +739,7 @@ struct ChunkParser {
       return;
     }
     if (!serial) {  // positions of earlier chunks may not be written yet
-      c.deferred.push_back({c.base_tri + itri, long(c.deferred_corners.size()), n});
+      c.deferred.push_back({c.base_tri + itri, long(c.deferred_corners.size()), n, line});
       c.deferred_corners.insert(c.deferred_corners.end(), poly.begin(), poly.end());
       for (int i = 2; i < n; ++i) emit(poly[0], poly[0], poly[0]);  // placeholders
       return;
@@ -739,7 +747,7 @@ struct ChunkParser {
     pts.resize(size_t(n));
     for (int i = 0; i < n; ++i) pts[size_t(i)] = m.positions[size_t(poly[size_t(i)].v)];
     ears.clear();
-    triangulate_polygon(pts.data(), n, ears, scratch);
+    if (triangulate_polygon(pts.data(), n, ears, scratch)) c.note_limited(line, n);
     for (auto& e : ears) emit(poly[size_t(e[0])], poly[size_t(e[1])], poly[size_t(e[2])]);
   }
 
@@ -809,7 +817,13 @@ struct ChunkParser {
   void grow_triangles() {
     auto& v = m.triangles;
     const double done = double(here - c.begin + 1), total = double(c.end - c.begin);
-    const size_t guess = size_t(double(v.size()) * (total / done) * 1.05) + 64;
+    // Never more than the rest of the file can hold: every further triangle
+    // needs a corner of at least 2 bytes ("1 "). Inside one long face the
+    // bytes read so far are few, and the extrapolation alone asked for
+    // terabytes (a 2 MB face of 1M corners: std::bad_alloc, issue 15).
+    const size_t most = v.size() + size_t(c.end - here) / 2 + 64;
+    const double estimate = double(v.size()) * (total / done) * 1.05 + 64;
+    const size_t guess = estimate < double(most) ? size_t(estimate) : most;
     v.reserve(std::max(guess, v.size() + v.size() / 2 + 64));
     advise_huge(v);
   }
@@ -1016,7 +1030,7 @@ void finish_chunk(Chunk& c, Mesh& m, bool first) {
     pts.resize(size_t(d.n));
     for (int i = 0; i < d.n; ++i) pts[size_t(i)] = m.positions[size_t(poly[i].v)];
     ears.clear();
-    triangulate_polygon(pts.data(), d.n, ears, scratch);
+    if (triangulate_polygon(pts.data(), d.n, ears, scratch)) c.note_limited(d.line, d.n);
     for (size_t k = 0; k < ears.size(); ++k) {
       MeshTriangle& t = m.triangles[size_t(d.tri) + k];
       for (int j = 0; j < 3; ++j) {
@@ -1089,6 +1103,12 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
   }
   if (chunks.size() > 1)
     run_parallel(chunks, [&](Chunk& c) { finish_chunk(c, m, &c == &chunks[0]); });
+  long limited = 0, limited_line = 0;
+  int limited_n = 0;
+  for (const auto& c : chunks) {  // in file order: the warning names the first such polygon
+    if (c.limited && !limited) limited_line = c.limited_first_line, limited_n = c.limited_first_n;
+    limited += c.limited;
+  }
   m.groups = std::move(groups.names);
   m.objects = std::move(objects.names);
   for (auto& u : unknown)
@@ -1100,6 +1120,12 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
                                  "face mixes vertex forms (v, v/vt, v//vn, v/vt/vn); texture or normal indices "
                                  "not on every corner were dropped (" +
                                      std::to_string(mixed) + (mixed == 1 ? " face)" : " faces)")));
+  if (limited)
+    m.warnings.push_back(located(m.path, limited_line,
+                                 "polygon of " + std::to_string(limited_n) + " corners is too irregular for ear "
+                                 "clipping within " + std::to_string(kEarClipWorkPerCorner) +
+                                 " steps a corner: its remaining corners were cut as a fan, whose triangles may "
+                                 "overlap (" + std::to_string(limited) + (limited == 1 ? " polygon)" : " polygons)")));
   resolve_materials(m, mats, mtllibs, opt);
 }
 

@@ -203,6 +203,10 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       }
       if (!ply_type(ty, pr.type)) t.fail("unknown property type '" + std::string(ty) + "'");
       pr.name = std::string(t.word());
+      for (const auto& other : elements.back().props)  // was "vertex element without x, y, z" for x, x, z
+        if (other.name == pr.name) t.fail("property '" + pr.name + "' given twice in one element");
+      if (pr.list && (pr.count_type == PlyType::F32 || pr.count_type == PlyType::F64))
+        t.fail("list count type must be an integer type");
       elements.back().props.push_back(std::move(pr));
       t.next_line();
     } else if (k == "end_header") {
@@ -304,6 +308,11 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
   Tokens t{text.data(), text.data() + text.size(), name};
   const std::string_view magic = t.word();
   if (!off_magic(magic)) t.fail("not an OFF file (header '" + std::string(magic.substr(0, 20)) + "', expected OFF, COFF, NOFF, CNOFF, STOFF ...)");
+  {  // "OFF BINARY" was "malformed vertex count 'BINARY'"
+    const char* q = t.p;
+    while (q < t.e && (*q == ' ' || *q == '\t')) ++q;
+    if (t.e - q >= 6 && std::string_view(q, 6) == "BINARY") t.fail("binary OFF is not supported (ASCII OFF only)");
+  }
   const long nv = t.number<long>("vertex count"), nf = t.number<long>("face count");
   t.number<long>("edge count");
   if (nv < 0 || nf < 0 || nv > (1L << 31) || nf > (1L << 31)) t.fail("counts out of range");

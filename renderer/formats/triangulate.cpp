@@ -21,12 +21,12 @@ bool in_triangle(const P2& p, const P2& a, const P2& b, const P2& c) {
 
 }  // namespace
 
-void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out,
+bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out,
                          EarClipScratch& s) {
-  if (n < 3) return;
+  if (n < 3) return false;
   if (n == 3) {
     out.push_back({0, 1, 2});
-    return;
+    return false;
   }
   // Newell normal, relative to pts[0].
   const Vec3d o = pts[0];
@@ -90,6 +90,7 @@ void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
   // Work limit (see triangulate.h): beyond it the rest is cut as a fan.
   long budget = kEarClipWorkPerCorner * long(n);
   int m = n, cur = 1, since_cut = 0;
+  bool limited = false;
   while (m > 3) {
     const int a_i = prev[size_t(cur)], c_i = next[size_t(cur)];
     bool ear = false;
@@ -123,6 +124,7 @@ void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
     }
     // An ear, or none in a whole turn (degenerate or not simple), or the
     // work limit spent: cut this corner anyway, so the count still holds.
+    limited = limited || (!ear && budget <= 0);
     out.push_back({a_i, cur, c_i});
     s.alive[size_t(cur)] = 0;
     next[size_t(a_i)] = c_i;
@@ -132,6 +134,7 @@ void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
     since_cut = 0;
   }
   out.push_back({prev[size_t(cur)], cur, next[size_t(cur)]});
+  return limited;
 }
 
 }  // namespace ra

@@ -14,7 +14,10 @@
 // kEarClipWorkPerCorner point tests a corner (a spiky polygon of hundreds of
 // thousands of corners, quadratic otherwise: 44 s for 200k corners) has its
 // remaining corners cut in order, like a degenerate one. So any file
-// triangulates in time linear in its size (issue 15).
+// triangulates in time linear in its size (issue 15). Those triangles may
+// overlap or leave gaps: triangulate_polygon returns true then, and the OBJ
+// reader warns "FILE:LINE: polygon of N corners ..." (the file still loads:
+// the mesh is what the file says up to that polygon's tiling).
 #pragma once
 #include <array>
 #include <vector>
@@ -32,7 +35,8 @@ struct EarClipScratch {
 };
 
 // Appends the triangles of polygon pts[0..n) as index triples into `out`.
-void triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out,
+// Returns true when the work limit was spent (the rest cut as a fan).
+bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out,
                          EarClipScratch& scratch);
 
 }  // namespace ra

@@ -13,9 +13,37 @@
 
 namespace ra {
 
+namespace {
+// Control bytes (a NUL, CR or newline quoted from a bad input) and bytes
+// that are not UTF-8 as \xNN: the message stays one printable line
+// whatever the file held.
+std::string printable(const std::string& s) {
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    std::size_t len = b < 0x80 ? 1 : b >= 0xc2 && b <= 0xdf ? 2 : b >= 0xe0 && b <= 0xef ? 3 : b >= 0xf0 && b <= 0xf4 ? 4 : 0;
+    for (std::size_t k = 1; k < len; ++k)
+      if (i + k >= s.size() || (static_cast<unsigned char>(s[i + k]) & 0xc0) != 0x80) len = 0;
+    if (len == 1 && (b < 0x20 || b == 0x7f)) len = 0;
+    if (len == 0) {
+      out += "\\x";
+      out += hex[b >> 4];
+      out += hex[b & 15];
+      ++i;
+      continue;
+    }
+    out.append(s, i, len);
+    i += len;
+  }
+  return out;
+}
+}  // namespace
+
 std::string located(const std::string& file, long line, const std::string& message) {
-  if (line > 0) return file + ":" + std::to_string(line) + ": " + message;
-  return file + ": " + message;
+  if (line > 0) return printable(file) + ":" + std::to_string(line) + ": " + printable(message);
+  return printable(file) + ": " + printable(message);
 }
 
 void write_atomically(const std::filesystem::path& path,
@@ -50,7 +78,21 @@ void check_output_path(const std::filesystem::path& path) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     throw InputError(located(path.string(), 0, "output directory does not exist"));
-  if (fs::is_directory(path, ec)) throw InputError(located(path.string(), 0, "is a directory, not a file"));
+  // An existing output that is not a regular file is refused: the renamed
+  // temporary would replace it (run as root, -o /dev/full turned the device
+  // into a file; issue 15's second pass).
+  const fs::file_status st = fs::status(path, ec);
+  if (st.type() == fs::file_type::not_found) return;
+  if (ec) throw InputError(located(path.string(), 0, "cannot write: " + ec.message()));
+  switch (st.type()) {
+    case fs::file_type::regular: return;
+    case fs::file_type::directory: throw InputError(located(path.string(), 0, "is a directory, not a file"));
+    case fs::file_type::fifo: throw InputError(located(path.string(), 0, "is a FIFO, not a file: not replaced"));
+    case fs::file_type::block:
+    case fs::file_type::character:
+      throw InputError(located(path.string(), 0, "is a device, not a file: not replaced"));
+    default: throw InputError(located(path.string(), 0, "is not a regular file: not replaced"));
+  }
 }
 
 namespace {

@@ -242,6 +242,11 @@ Object parse_object(const json& j, const std::string& path, const std::filesyste
       place.material_override = parse_material(r.get("material"), r.at("material"), file);
     }
     if (const auto why = file_problem(place.file); !why.empty()) r.fail(r.at("mesh"), why);
+    try {
+      check_mesh_format(place.file);
+    } catch (const InputError& e) {
+      r.fail(r.at("mesh"), e.what());
+    }
     r.finish();
     o.mesh = load_placed_mesh(place);
     return o;
@@ -307,6 +312,7 @@ Scene parse_scene_json(const std::string& text, const std::filesystem::path& fil
 
 Scene load_scene(const std::filesystem::path& file) {
   check_input_file(file);  // "is a directory", not "no such file"
+  check_mesh_format(file);
   std::string ext = file.extension().string();
   for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
   if (ext == ".obj") {

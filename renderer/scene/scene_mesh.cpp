@@ -57,7 +57,17 @@ Vec3d place_normal(const MeshPlacement& pl, Vec3d n) {
 
 }  // namespace
 
+void check_mesh_format(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  // Read as OBJ, a PLY or OFF file was "NUL byte in a text file" or "invalid JSON".
+  if (ext == ".ply" || ext == ".off")
+    throw InputError(located(file.string(), 0, "a " + ext.substr(1) + " mesh: scenes take OBJ; convert it first "
+                                                "(rayaudit convert " + file.filename().string() + " -o NAME.obj)"));
+}
+
 std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {
+  check_mesh_format(place.file);
   ObjOptions opt;
   opt.threads = 0;  // identical to serial (obj_loader.cpp); faster on the dragon
   Mesh mesh = load_obj(place.file, opt);

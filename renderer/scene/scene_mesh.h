@@ -39,6 +39,10 @@ Material material_from_mtl(const MtlMaterial& m, std::vector<std::string>* warni
 // The loader's warnings go to stderr, each prefixed "warning: ".
 std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place);
 
+// Throws InputError for a .ply or .off path (scenes and render take OBJ;
+// `rayaudit convert` makes one), so it is not misread as OBJ or JSON.
+void check_mesh_format(const std::filesystem::path& file);
+
 // The cache of downloaded and generated data: $RAYAUDIT_CACHE, else
 // $HOME/.cache/rayaudit (ci/fetch-corpus.sh fills <cache>/corpus).
 std::filesystem::path cache_dir();

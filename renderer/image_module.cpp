@@ -1,0 +1,73 @@
+// Finds and loads the image module (image_module.h) on first use, so that a
+// process which never touches an image never maps OpenImageIO.
+#include "image_module.h"
+
+#include <dlfcn.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <string>
+
+#include "errors.h"
+
+namespace ra::image_module {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Where the module may be, most specific first (see api()).
+std::vector<std::string> candidates() {
+  std::vector<std::string> out;
+  if (const char* env = std::getenv("RAYAUDIT_IMAGE_MODULE"); env && *env) return {env};
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    out.push_back((exe.parent_path() / kFileName).string());
+    out.push_back((exe.parent_path().parent_path() / RAYAUDIT_INSTALL_LIBDIR / "rayaudit" / kFileName).string());
+  }
+  out.push_back(kFileName);  // no slash: dlopen searches the executable's RUNPATH
+  out.push_back((fs::path(RAYAUDIT_INSTALL_FULL_LIBDIR) / "rayaudit" / kFileName).string());
+  return out;
+}
+
+const Api* load() {
+  std::string tried;
+  for (const std::string& path : candidates()) {
+    const bool by_name = path.find('/') == std::string::npos;
+    std::error_code ec;
+    tried += (tried.empty() ? "" : ", ") + (by_name ? "the library path" : path);
+    if (!by_name && !fs::exists(path, ec)) continue;
+    void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      // A file that is there but does not load (a missing OpenImageIO
+      // library, a wrong architecture) is the answer, not the next place.
+      if (!by_name) throw InputError(located(path, 0, std::string("cannot load the image module: ") + ::dlerror()));
+      ::dlerror();
+      continue;
+    }
+    using Entry = const Api* (*)();
+    auto entry = reinterpret_cast<Entry>(::dlsym(handle, "rayaudit_image_module_api"));
+    const Api* api = entry ? entry() : nullptr;
+    if (!api || api->version != kVersion || api->size != sizeof(Api))
+      throw InputError(located(path, 0, "not the image module of this rayaudit (version " RAYAUDIT_VERSION
+                                        "): rebuild or reinstall it"));
+    return api;
+  }
+  throw InputError(located(kFileName, 0,
+                           "the image module (OpenImageIO reading and writing) is not installed: looked for " +
+                               tried + "; set RAYAUDIT_IMAGE_MODULE to its path"));
+}
+
+}  // namespace
+
+const Api& api() {
+  // Loaded once; a failure is thrown again on every call.
+  static std::mutex m;
+  static const Api* loaded = nullptr;
+  std::lock_guard<std::mutex> lock(m);
+  if (!loaded) loaded = load();
+  return *loaded;
+}
+
+}  // namespace ra::image_module
