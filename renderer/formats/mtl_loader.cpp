@@ -18,7 +18,7 @@
 #include <cstring>
 
 #include "mesh.h"
-#include "input_file.h"
+#include "../io/input_file.h"
 #include "obj_text.h"
 
 namespace ra {
