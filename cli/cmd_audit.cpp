@@ -18,7 +18,9 @@
 #include "cases_csv.h"
 #include "command.h"
 #include "errors.h"
+#include "file_identity.h"
 #include "grade.h"
+#include "input_file.h"
 #include "registry.h"
 
 namespace {
@@ -257,7 +259,7 @@ void export_cases(const Args& a) {
   if (a.rays > kMaxExportRays)
     throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
                          std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
-  ra::check_output_path(a.export_cases);
+  ra::declare_output(a.export_cases);
   const auto precisions = chosen_precisions(a.precision);
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
@@ -319,6 +321,7 @@ struct ShardFile {
 };
 
 ShardFile read_shard(const std::string& path) {
+  ra::check_input_file(path);  // a directory or FIFO named, not read or waited on
   std::ifstream in(path);
   if (!in) throw ra::InputError(ra::located(path, 0, "cannot open the shard's JSON"));
   ShardFile f{path, nlohmann::json::parse(in, nullptr, false), {}};

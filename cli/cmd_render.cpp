@@ -5,6 +5,7 @@
 #include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "file_identity.h"
 #include "image_module.h"
 #include "registry.h"
 #include "render.h"
@@ -82,7 +83,7 @@ void run(const Args& a) {
     if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR")
       throw ra::InputError(a.out + ": output must be .png or .exr");
     // Its directory too: a missing one used to be found after the render.
-    ra::check_output_path(a.out);
+    ra::declare_output(a.out);  // and not an input (the scene's textures are checked on loading)
     // And the image module that will write it (loaded now, not after the render).
     ra::image_module::api();
   }

@@ -13,6 +13,7 @@
 #include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "input_file.h"
 #include "registry.h"
 
 namespace {
@@ -33,8 +34,7 @@ std::string python() {
 fs::path script() { return fs::path(RAYAUDIT_SOURCE_DIR) / "validation" / "report" / "report.py"; }
 
 std::string read_file(const fs::path& f) {
-  if (!fs::exists(f)) throw ra::InputError(f.string() + ": no such file");
-  if (!fs::is_regular_file(f)) throw ra::InputError(f.string() + ": not a regular file");
+  ra::check_input_file(f);  // what it is if not a file; an output naming it is refused
   std::ifstream in(f, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();

@@ -250,4 +250,92 @@ TEST(ReliabilityCli, OutputThatIsAFifoIsRefusedNotReplaced) {
   fs::remove(fifo);
 }
 
+// A scene with a mesh and a texture in a fresh directory: its files are
+// the inputs the output tests below name as outputs.
+fs::path textured_scene_dir(const std::string& name) {
+  const fs::path d = scratch(name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  fs::copy_file(kScenes + "/meshes/quad.obj", d / "m.obj");
+  fs::copy_file(kScenes + "/textures/uv-grid.png", d / "tex.png");
+  std::ofstream(d / "s.json") << R"({"width": 8, "height": 8, "objects": [{"mesh": "m.obj", "material": {"texture": "tex.png"}}]})"
+                              << "\n";
+  return d;
+}
+
+// An output that is one of the command's inputs (the scene, the mesh or
+// texture it references, the cases CSV) is refused before the work: the
+// rename replaced the input (issue 15's second pass: `render s.json -o
+// tex.png`, `export-pov --ini s.json`, `audit --cases c.csv --json c.csv`).
+TEST(ReliabilityCli, OutputThatIsAnInputIsRefusedAndTheInputKept) {
+  const fs::path d = textured_scene_dir("out-is-input");
+  const fs::path cases = d / "c.csv";
+  ASSERT_EQ(run_rayaudit("audit --export-cases " + cases.string() + " --families edge --rays 10").code, 0);
+  fs::create_symlink(d / "tex.png", d / "link.png");
+  const std::string s = (d / "s.json").string();
+  struct Case {
+    std::string args;
+    fs::path input;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"render " + s + " -o " + (d / "tex.png").string(), d / "tex.png"},
+           {"render " + s + " -o " + (d / "link.png").string(), d / "tex.png"},
+           {"export-pov " + s + " -o " + (d / "x.pov").string() + " --ini " + s, d / "s.json"},
+           {"audit --cases " + cases.string() + " --methods moller --json " + cases.string(), cases}}) {
+    const std::string before = slurp(c.input);
+    const auto r = run_rayaudit(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find("is also an input of this command"), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(slurp(c.input), before) << "replaced by " << c.args;
+  }
+  EXPECT_FALSE(fs::exists(d / "x.pov"));
+  EXPECT_TRUE(fs::is_symlink(d / "link.png"));
+}
+
+// Two outputs of one command on one path: the later replaced the earlier
+// (`--json X --csv X`; an --ini named like the texture export-pov copies).
+TEST(ReliabilityCli, TwoOutputsOnOnePathAreRefused) {
+  const fs::path d = textured_scene_dir("two-outputs");
+  const std::string same = (d / "same").string();
+  for (const std::string& args : std::vector<std::string>{
+           "audit --rays 50 --families edge --methods moller --json " + same + " --csv " + same,
+           "export-pov " + (d / "s.json").string() + " -o " + (d / "x.pov").string() + " --ini " +
+               (d / "x-tex0.png").string()}) {
+    const auto r = run_rayaudit(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find("is named as two outputs of this command"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(same));
+  EXPECT_FALSE(fs::exists(d / "x.pov"));
+  EXPECT_FALSE(fs::exists(d / "x-tex0.png"));
+}
+
+// crack-maps names every map before the work: a --mesh named like the
+// built-in sphere would share its maps' names (one of each pair lost), and a
+// name longer than the file system takes failed after the work, leaving a
+// partial directory. Both are refused first, and no directory is left.
+TEST(ReliabilityCli, CrackMapsRefusesCollidingAndOverlongNamesBeforeTheWork) {
+  const fs::path d = scratch("crack-names");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  std::ofstream(d / "sphere.obj") << tetra;
+  const std::string long_stem(248, 'm');
+  std::ofstream(d / (long_stem + ".obj")) << tetra;
+  const std::string cm = (d / "cm").string();
+  const auto a = run_rayaudit("crack-maps -o " + cm + " --methods moller --offsets 1 --size 8 --mesh " +
+                              (d / "sphere.obj").string());
+  EXPECT_EQ(a.code, 2) << a.all;
+  EXPECT_TRUE(one_line(a.err)) << a.err;
+  EXPECT_NE(a.err.find("sphere-moller-1.png: two maps would have this name"), std::string::npos) << a.err;
+  const auto b = run_rayaudit("crack-maps -o " + cm + " --methods moller --offsets 1 --size 8 --mesh " +
+                              (d / (long_stem + ".obj")).string());
+  EXPECT_EQ(b.code, 2) << b.all;
+  EXPECT_TRUE(one_line(b.err)) << b.err;
+  EXPECT_NE(b.err.find("file name too long"), std::string::npos) << b.err;
+  EXPECT_FALSE(fs::exists(cm)) << "left behind";
+}
+
 }  // namespace

@@ -666,7 +666,9 @@ struct ChunkParser {
       if (i > count) past_the_end(kind, i, count, se, line);
       out = int(i - 1);
     } else {
-      if (-i > count)
+      // i < -count, not -i > count: -i overflows for i = -2^63 (which
+      // then passed and read before the first vertex; issue 15).
+      if (i < -static_cast<long long>(count))
         w.fail(line, std::string("relative ") + kind + " index " + std::to_string(i) +
                          " reaches before the first one (" + std::to_string(count) + " defined before this face)");
       out = int(count + i);

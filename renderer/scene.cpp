@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "errors.h"
+#include "file_identity.h"
 #include "input_file.h"
 #include "json_input.h"
 #include "scene_mesh.h"
@@ -25,7 +26,10 @@ using json = nlohmann::json;
 // (a directory, a FIFO that would block, a device); empty when it is one.
 std::string file_problem(const std::filesystem::path& p) {
   const std::string why = input_file_problem(p);
-  if (why.empty()) return why;
+  if (why.empty()) {
+    note_input(p);  // a texture or mesh is never replaced by an output
+    return why;
+  }
   return why == "no such file" ? "file not found: " + p.string() : p.string() + ": " + why;
 }
 

@@ -9,6 +9,7 @@
 
 #include "atomic_file.h"
 #include "errors.h"
+#include "input_file.h"
 #include "json_input.h"
 #include "render.h"
 #include "scene_mesh.h"
@@ -31,6 +32,7 @@ std::string fnv1a64_hex(const std::string& bytes) {
 }
 
 std::string read_bytes(const fs::path& p) {
+  check_input_file(p);  // what it is if not a file; an output naming it is refused
   std::ifstream in(p, std::ios::binary);
   if (!in) throw InputError(located(p.string(), 0, "cannot read"));
   std::ostringstream ss;

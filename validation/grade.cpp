@@ -12,6 +12,7 @@
 
 #include "cases_csv.h"
 #include "errors.h"
+#include "input_file.h"
 
 namespace ra::audit {
 
@@ -30,6 +31,7 @@ struct Given {
 };
 
 std::unordered_map<std::string, Given> read_answers(const std::string& path) {
+  check_input_file(path);  // a directory, FIFO or /dev/zero named, not read
   std::ifstream in(path);
   if (!in) throw InputError(located(path, 0, "cannot open the answers file"));
   std::string line;

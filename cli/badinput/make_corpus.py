@@ -217,3 +217,10 @@ put('mtl', 'map_kd_directory.mtl', 'newmtl a\nmap_Kd ../texture/is_a_directory.p
 loop = os.path.join(HERE, 'texture', 'symlink_loop.png')
 if not os.path.islink(loop):
     os.symlink('symlink_loop.png', loop)
+
+# Third pass (issue 15): -2^63 as a relative index (its negation overflowed,
+# and the index read before the first vertex).
+V3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+put("obj", "face_index_neg_2p63.obj", V3 + "f 1 2 -9223372036854775808\n")
+put("obj", "vt_index_neg_2p63.obj", V3 + "vt 0 0\nf 1/1 2/1 3/-9223372036854775808\n")
+put("obj", "vn_index_neg_2p63.obj", V3 + "vn 0 0 1\nf 1//1 2//1 3//-9223372036854775808\n")
