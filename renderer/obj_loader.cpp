@@ -711,6 +711,9 @@ struct ChunkParser {
     for (;;) {
       p = skip_ws(p, se);
       if (p >= se || *p == '#') break;
+      if (poly.size() == size_t(kMaxPolygonCorners))
+        w.fail(line, "face of more than " + std::to_string(kMaxPolygonCorners) +
+                         " corners (the limit a polygon; split it)");
       poly.push_back({-1, -1, -1});  // parsed in place (no copy of a temporary)
       Corner& k = poly.back();
       p = parse_index(p, se, nv, "vertex", line, k.v);
