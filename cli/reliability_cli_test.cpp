@@ -338,4 +338,20 @@ TEST(ReliabilityCli, CrackMapsRefusesCollidingAndOverlongNamesBeforeTheWork) {
   EXPECT_FALSE(fs::exists(cm)) << "left behind";
 }
 
+// A cases header of 200k columns with a repeat at its end: the repeat search
+// compared all pairs (over 20 s). Under a 20 s CPU limit (a bound against
+// runaway, not a timing) it answers with the repeated column.
+TEST(ReliabilityCli, CasesHeaderOf200kColumnsIsCheckedInLinearTime) {
+  const fs::path csv = scratch("wide.csv");
+  {
+    std::ofstream out(csv);
+    out << "ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz";
+    for (int i = 0; i < 200000; ++i) out << ",c" << i;
+    out << ",c5\n";
+  }
+  const auto r = run_rayaudit("audit --cases " + csv.string() + " --methods moller", "prlimit --cpu=20 --");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, csv.string() + ":1: column 'c5' appears twice in the header\n");
+}
+
 }  // namespace

@@ -115,6 +115,14 @@ struct NameTable {
   }
 };
 
+// Distinct unsupported keywords warned one line each; the rest in one line.
+constexpr std::size_t kMaxKeywordWarnings = 10;
+
+// A keyword quoted in a warning: at most 40 bytes of it.
+std::string short_quote(const std::string& s) {
+  return s.size() > 40 ? s.substr(0, 40) + "... (" + std::to_string(s.size()) + " bytes)" : s;
+}
+
 struct Unknown {
   std::string keyword;
   long first_line;
@@ -146,6 +154,7 @@ struct Chunk {
   long vp = 0, l = 0, p = 0;
   std::vector<std::pair<long, std::string>> mtllibs;
   std::vector<Unknown> unknown;
+  std::unordered_map<std::string, std::size_t> unknown_at;  // keyword -> index: linear in distinct ones
   long mixed = 0, mixed_first_line = 0;
   // parallel: polygons (n > 3) whose n-2 triangle slots are filled in step 2,
   // when every chunk's positions are in place
@@ -869,13 +878,12 @@ struct ChunkParser {
   }
 
   void unknown(const char* k, const char* kend, long line) {
-    const std::string_view kw(k, size_t(kend - k));
-    for (auto& u : c.unknown)
-      if (u.keyword == kw) {
-        ++u.count;
-        return;
-      }
-    c.unknown.push_back({std::string(kw), line, 1});
+    // A map, not a scan of those seen: 100k distinct unknown keywords
+    // took over 20 s (issue 15).
+    std::string kw(k, size_t(kend - k));
+    const auto [it, fresh] = c.unknown_at.try_emplace(kw, c.unknown.size());
+    if (fresh) c.unknown.push_back({std::move(kw), line, 1});
+    else ++c.unknown[it->second].count;
   }
 };
 
@@ -1068,6 +1076,7 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
   NameTable mats, groups, objects;
   int s_mat = -1, s_group = -1, s_object = -1, s_smooth = 0;
   std::vector<Unknown> unknown;
+  std::unordered_map<std::string, std::size_t> unknown_at;
   long mixed = 0, mixed_line = 0;
   std::vector<std::pair<long, std::string>> mtllibs;
   for (auto& c : chunks) {
@@ -1097,11 +1106,9 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
     m.skipped.p += c.p;
     mtllibs.insert(mtllibs.end(), c.mtllibs.begin(), c.mtllibs.end());
     for (auto& u : c.unknown) {
-      auto it = std::find_if(unknown.begin(), unknown.end(), [&](auto& x) { return x.keyword == u.keyword; });
-      if (it == unknown.end())
-        unknown.push_back(u);
-      else
-        it->count += u.count;
+      const auto [it, fresh] = unknown_at.try_emplace(u.keyword, unknown.size());
+      if (fresh) unknown.push_back(u);
+      else unknown[it->second].count += u.count;
     }
     if (c.mixed && mixed == 0) mixed_line = c.mixed_first_line;
     mixed += c.mixed;
@@ -1116,10 +1123,22 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
   }
   m.groups = std::move(groups.names);
   m.objects = std::move(objects.names);
-  for (auto& u : unknown)
+  // The first kMaxKeywordWarnings keywords one line each, the rest in one
+  // line: 100k distinct ones printed 100k warnings.
+  for (std::size_t i = 0; i < unknown.size() && i < kMaxKeywordWarnings; ++i) {
+    const Unknown& u = unknown[i];
     m.warnings.push_back(located(m.path, u.first_line,
-                                 "unsupported statement '" + u.keyword + "' ignored (" + std::to_string(u.count) +
-                                     (u.count == 1 ? " line)" : " lines)")));
+                                 "unsupported statement '" + short_quote(u.keyword) + "' ignored (" +
+                                     std::to_string(u.count) + (u.count == 1 ? " line)" : " lines)")));
+  }
+  if (unknown.size() > kMaxKeywordWarnings) {
+    long lines = 0;
+    for (std::size_t i = kMaxKeywordWarnings; i < unknown.size(); ++i) lines += unknown[i].count;
+    m.warnings.push_back(located(m.path, unknown[kMaxKeywordWarnings].first_line,
+                                 std::to_string(unknown.size() - kMaxKeywordWarnings) +
+                                     " more unsupported keywords ignored (" + std::to_string(lines) +
+                                     (lines == 1 ? " line)" : " lines)")));
+  }
   if (mixed)
     m.warnings.push_back(located(m.path, mixed_line,
                                  "face mixes vertex forms (v, v/vt, v//vn, v/vt/vn); texture or normal indices "
