@@ -354,4 +354,28 @@ TEST(ReliabilityCli, CasesHeaderOf200kColumnsIsCheckedInLinearTime) {
   EXPECT_EQ(r.err, csv.string() + ":1: column 'c5' appears twice in the header\n");
 }
 
+// A golden manifest claiming 16384x16384 for an 8x8 golden: the golden's
+// size is compared first, not after a 3.3 GB render of the claimed size
+// (which a 1 GB address-space limit turns into a failed allocation).
+TEST(ReliabilityCli, GoldenSizeIsComparedBeforeRenderingTheManifestsSize) {
+  SKIP_IF_SANITIZED();
+  const fs::path root = scratch("golden-size");
+  fs::remove_all(root);
+  fs::create_directories(root / "scenes");
+  fs::create_directories(root / "golden");
+  std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}}]})"
+                                             << "\n";
+  ASSERT_EQ(run_rayaudit("golden bless t --root " + root.string()).code, 0);
+  std::string manifest = slurp(root / "golden" / "manifest.json");
+  for (const char* key : {"\"width\": ", "\"height\": "}) {
+    const auto at = manifest.find(key) + std::string(key).size();
+    manifest.replace(at, manifest.find_first_of(",\n", at) - at, "16384");
+  }
+  std::ofstream(root / "golden" / "manifest.json") << manifest;
+  const auto r = run_rayaudit("golden check --root " + root.string() + " --diff-dir " + (root / "d").string(),
+                              "prlimit --as=1000000000 --");
+  EXPECT_EQ(r.code, 1) << r.all;
+  EXPECT_NE(r.all.find("but the manifest says 16384x16384"), std::string::npos) << r.all;
+}
+
 }  // namespace
