@@ -14,6 +14,7 @@
 #include "atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "memory_budget.h"
 #include "golden.h"
 #include "image_compare.h"
 #include "pov_explain.h"
@@ -145,6 +146,8 @@ void run(const Args& a) {
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
   if (a.height > 0) scene.height = a.height;
+  // Ours, POV-Ray's as read, the difference and their encodings.
+  ra::check_image_memory("compare", scene.width, scene.height, 64);
   if (auto reason = ra::pov_inexpressible(scene)) {
     if (a.skip_inexpressible) {
       std::cout << "skipped: POV-Ray cannot express " << a.scene << ": " << *reason << "\n";

@@ -7,6 +7,7 @@
 #include "errors.h"
 #include "file_identity.h"
 #include "image_module.h"
+#include "memory_budget.h"
 #include "registry.h"
 #include "render.h"
 #include "scene.h"
@@ -92,6 +93,9 @@ void run(const Args& a) {
   if (a.height > 0) scene.height = a.height;
   if (a.width > 0 || a.height > 0) ra::apply_content_defaults(scene);
   check_work(scene, a.spp);
+  // The image (12 bytes a pixel) and its encoded copies (up to 6 + 6 at
+  // 16 bits), refused now rather than as a bad_alloc after the render.
+  ra::check_image_memory("render", scene.width, scene.height, 24);
   const ra::Image img = ra::render(scene, opt);
   ra::write_image(a.out, img, {a.bits, a.srgb});
 }

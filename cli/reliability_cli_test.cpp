@@ -378,4 +378,18 @@ TEST(ReliabilityCli, GoldenSizeIsComparedBeforeRenderingTheManifestsSize) {
   EXPECT_NE(r.all.find("but the manifest says 16384x16384"), std::string::npos) << r.all;
 }
 
+// A render whose image buffers exceed the memory left is refused before
+// the work with its estimate (it died of a bare std::bad_alloc after 37 s).
+TEST(ReliabilityCli, RenderBeyondTheMemoryLimitIsRefusedWithAnEstimate) {
+  SKIP_IF_SANITIZED();
+  const fs::path out = scratch("huge.png");
+  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 -o " +
+                                  out.string(),
+                              "prlimit --as=2000000000 --");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind("render: 16384x16384 needs about 6144 MB for its image buffers, but only ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
