@@ -64,7 +64,7 @@ std::vector<const ra::Method*> chosen_methods(const std::string& list) {
       if (m.kind != ra::Kind::plane) out.push_back(&m);
     return out;
   }
-  for (const auto& name : split_list(list)) {
+  for (const auto& name : split_list(list, "--methods")) {
     const ra::Method* m = ra::find_method(name);
     if (!m)
       throw ra::InputError("audit: unknown method '" + name + "' (triangle: " +
@@ -79,7 +79,7 @@ std::vector<const ra::Method*> chosen_methods(const std::string& list) {
 
 std::vector<Precision> chosen_precisions(const std::string& list) {
   std::vector<Precision> out;
-  for (const auto& p : split_list(list)) {
+  for (const auto& p : split_list(list, "--precision")) {
     if (p == "float") out.push_back(Precision::f32);
     else if (p == "double") out.push_back(Precision::f64);
     else throw ra::InputError("audit: unknown precision '" + p + "' (float, double)");
@@ -89,7 +89,7 @@ std::vector<Precision> chosen_precisions(const std::string& list) {
 }
 
 std::vector<std::string> chosen_families(const std::string& list) {
-  const auto names = split_list(list);
+  const auto names = split_list(list, "--families");
   for (const auto& n : names)
     if (!find_family(n))
       throw ra::InputError("audit: unknown family '" + n + "' (" + family_names() + ")");
@@ -394,9 +394,11 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "audit", "Grade intersection methods against exact arithmetic (CGAL/GMP) on generated or given cases");
   auto a = std::make_shared<Args>();
-  cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)");
-  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str();
-  cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names());
+  cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)")
+      ->check(ra::cli::non_empty_list());
+  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
+  cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names())
+      ->check(ra::cli::non_empty_list());
   cmd->add_option("--rays", a->rays,
                   "Ray/primitive tests per family per method and precision (a ray against a fan of 6 counts 6)")
       ->capture_default_str()

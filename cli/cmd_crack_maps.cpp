@@ -26,7 +26,7 @@ struct Args {
 
 std::vector<double> parse_offsets(const std::string& list) {
   std::vector<double> out;
-  for (const auto& s : split_list(list)) {
+  for (const auto& s : split_list(list, "--offsets")) {
     std::size_t used = 0;
     double v = 0;
     try {
@@ -39,6 +39,11 @@ std::vector<double> parse_offsets(const std::string& list) {
     out.push_back(v);
   }
   if (out.empty()) throw ra::InputError("--offsets: give at least one offset");
+  // Each offset is a map per mesh and method: 50k offsets ran for minutes.
+  constexpr std::size_t kMaxOffsets = 100;
+  if (out.size() > kMaxOffsets)
+    throw ra::InputError("--offsets: " + std::to_string(out.size()) + " offsets, more than the limit of " +
+                         std::to_string(kMaxOffsets));
   return out;
 }
 
@@ -72,7 +77,7 @@ void run(const Args& a) {
   opt.size = a.size;
   opt.threads = a.threads;
   opt.offsets = parse_offsets(a.offsets);
-  opt.methods = split_list(a.methods);
+  opt.methods = split_list(a.methods, "--methods");
   opt.progress = progress_count();
   const std::filesystem::path dir(a.out);
   if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))
@@ -161,8 +166,10 @@ void setup(CLI::App& app) {
       ->required();
   cmd->add_option("--mesh", a->meshes,
                   "A closed OBJ to map besides the audit's sphere (default: the ladder's elephant_cgal.obj, 5,558 triangles)");
-  cmd->add_option("--offsets", a->offsets, "Comma-separated offsets of the mesh centre (o, o, o)")->capture_default_str();
-  cmd->add_option("--methods", a->methods, "Comma-separated triangle methods (default: all)");
+  cmd->add_option("--offsets", a->offsets, "Comma-separated offsets of the mesh centre (o, o, o)")
+      ->capture_default_str()
+      ->check(ra::cli::non_empty_list());
+  cmd->add_option("--methods", a->methods, "Comma-separated triangle methods (default: all)")->check(ra::cli::non_empty_list());
   cmd->add_option("--size", a->size, "Pixels a side")->capture_default_str();
   cmd->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   cmd->callback([a] { run(*a); });

@@ -392,4 +392,27 @@ TEST(ReliabilityCli, RenderBeyondTheMemoryLimitIsRefusedWithAnEstimate) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// An empty item in a list option was dropped (`--offsets 1,,2`), and an
+// empty list meant "all" (`--methods ''`, `--families ,`): both refused.
+TEST(ReliabilityCli, ListOptionsWithAnEmptyItemAreRefused) {
+  const fs::path out = scratch("list.json");
+  struct Case {
+    std::string args, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"audit --rays 5 --families edge,,vertex --json " + out.string(), "--families: empty item in the list 'edge,,vertex'"},
+           {"audit --rays 5 --families , --json " + out.string(), "--families: empty item in the list ','"},
+           {"audit --rays 5 --methods moller, --json " + out.string(), "--methods: empty item in the list 'moller,'"},
+           {"audit --rays 5 --precision float, --json " + out.string(), "--precision: empty item in the list 'float,'"},
+           {"audit --rays 5 --methods '' --json " + out.string(), "--methods: empty list"},
+           {"crack-maps -o " + scratch("cm-list").string() + " --offsets 1,,2", "--offsets: empty item in the list '1,,2'"}}) {
+    const auto r = run_rayaudit(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(scratch("cm-list")));
+}
+
 }  // namespace
