@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -274,6 +275,47 @@ TEST(AuditShards, MergingShardsOfDifferentRunsIsAnErrorNamingBothFiles) {
   EXPECT_EQ(rayaudit(run + " --shard 0/2").code, 2);
   EXPECT_EQ(rayaudit(run + " --shard 3/2").code, 2);
   EXPECT_EQ(rayaudit(run + " --shard 1").code, 2);
+}
+
+// Hostile shards (issue 15's third pass): a count near 2^64 wrapped when
+// merged, a shard count of 4e9 was a bad_alloc, a key given twice was
+// resolved silently, a directory was a raw library error.
+TEST(AuditShards, HostileShardsAreOneLineErrors) {
+  const std::string run = "audit --methods moller --families edge --rays 200";
+  const fs::path a = tmp("h1.json"), b = tmp("h2.json"), out = tmp("hout.json");
+  ASSERT_EQ(rayaudit(run + " --shard 1/2 --json " + a.string()).code, 0);
+  ASSERT_EQ(rayaudit(run + " --shard 2/2 --json " + b.string()).code, 0);
+  auto one_error = [&](const fs::path& first, const fs::path& second, const std::string& says) {
+    const Result r = rayaudit("audit merge " + first.string() + " " + second.string() + " --json " + out.string());
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  };
+  auto jb = nlohmann::json::parse(slurp(b));
+  jb["cells"][0]["stats"]["tests"] = std::numeric_limits<std::uint64_t>::max();
+  const fs::path big = tmp("hbig.json");
+  write(big, jb.dump());
+  auto ja = nlohmann::json::parse(slurp(a));
+  ja["cells"][0]["stats"]["tests"] = 20;
+  const fs::path small = tmp("hsmall.json");
+  write(small, ja.dump());
+  one_error(small, big, big.string() + ": a count overflows 2^64-1 when merged");
+  auto huge = [&](const fs::path& from, const fs::path& to) {
+    auto j = nlohmann::json::parse(slurp(from));
+    j["shard"]["n"] = 4000000000ULL;
+    write(to, j.dump());
+  };
+  const fs::path ha = tmp("hna.json"), hb = tmp("hnb.json");
+  huge(a, ha);
+  huge(b, hb);
+  one_error(ha, hb, "audit merge: shard 3/4000000000 is missing");
+  const std::string text = slurp(a);
+  const fs::path dup = tmp("hdup.json");
+  write(dup, "{\"seed\": 1,\n" + text.substr(text.find('{') + 1));
+  one_error(dup, b, dup.string() + ":");
+  one_error(dup, b, "given twice in one object");
+  one_error(tmp(""), b, ": is a directory, not a file");
 }
 
 // -------------------------------------------------------- --grade ---
