@@ -1,6 +1,7 @@
 // Tests of `rayaudit audit` run as a user would (cli/cmd_audit.cpp): exit
 // codes, the --cases JSON shape, malformed input, export round trip, determinism.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "run_rayaudit.h"
 
@@ -374,6 +375,28 @@ TEST(AuditGrade, BadAnswersExitTwoWithFileLineAndWriteNothing) {
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
   EXPECT_EQ(rayaudit("audit --grade " + answers.string()).code, 2) << "--grade needs --cases";
+}
+
+// Answers as spreadsheets save them: a UTF-8 BOM is dropped (it read
+// "missing column 'id'"); UTF-16 is named; a directory or FIFO as answers is
+// named, not read as "empty file" or waited on (issue 15's third pass).
+TEST(AuditGrade, AnswersEncodingAndNonFilesAreNamed) {
+  const fs::path cases = tmp("ge_cases.csv"), answers = tmp("ge_answers.csv"), json = tmp("ge.json");
+  write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\na,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
+  const std::string grade = "audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string();
+  write(answers, "\xEF\xBB\xBFid,hit,t\na,true,1\n");
+  Result r = rayaudit(grade);
+  EXPECT_EQ(r.code, 0) << r.err;
+  write(answers, std::string("\xFF\xFEi\0d\0", 6));
+  r = rayaudit(grade);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, answers.string() + ":1: the file is UTF-16 (or holds NUL bytes): save it as UTF-8 or ASCII\n");
+  fs::remove(answers);
+  ASSERT_EQ(::mkfifo(answers.c_str(), 0644), 0);
+  r = rayaudit(grade);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, answers.string() + ": is a FIFO, not a file\n");
+  fs::remove(answers);
 }
 
 // ------------------------------------------------- --cases memory ---

@@ -29,14 +29,6 @@ std::string hex(double x) {
   return buf;
 }
 
-// The header line as UTF-8 text: a UTF-8 byte-order mark (as spreadsheets
-// write) is dropped; UTF-16 (a BOM or NUL bytes) is refused by name rather
-// than reported as a missing column.
-void check_header_encoding(const std::string& path, long lineno, std::string& line) {
-  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
-  if (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0 || line.find('\0') != std::string::npos)
-    throw InputError(located(path, lineno, "the file is UTF-16 (or holds NUL bytes): save it as UTF-8 or ASCII"));
-}
 
 // A column named twice would make one of the two silently ignored.
 void check_unique_columns(const std::string& path, long lineno, const std::vector<std::string>& header) {
@@ -49,6 +41,15 @@ void check_unique_columns(const std::string& path, long lineno, const std::vecto
 }
 
 }  // namespace
+
+// The header line as UTF-8 text: a UTF-8 byte-order mark (as spreadsheets
+// write) is dropped; UTF-16 (a BOM or NUL bytes) is refused by name rather
+// than reported as a missing column.
+void check_header_encoding(const std::string& path, long lineno, std::string& line) {
+  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+  if (line.rfind("\xFF\xFE", 0) == 0 || line.rfind("\xFE\xFF", 0) == 0 || line.find('\0') != std::string::npos)
+    throw InputError(located(path, lineno, "the file is UTF-16 (or holds NUL bytes): save it as UTF-8 or ASCII"));
+}
 
 std::vector<std::string> split_fields(const std::string& line, char sep) {
   std::vector<std::string> out;

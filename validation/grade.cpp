@@ -40,6 +40,7 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
   while (header.empty() && std::getline(in, line)) {
     ++lineno;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    check_header_encoding(path, lineno, line);  // a BOM dropped, UTF-16 named (was "missing column 'id'")
     if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
   }
   if (header.empty()) throw InputError(located(path, lineno, "empty file: expected a header line id,hit,t"));
