@@ -415,4 +415,16 @@ TEST(ReliabilityCli, ListOptionsWithAnEmptyItemAreRefused) {
   EXPECT_FALSE(fs::exists(scratch("cm-list")));
 }
 
+// export-pov copies a scene's texture: a truncated PNG printed libpng's own
+// lines (3-4 on stderr, the first naming no file) before the error.
+TEST(ReliabilityCli, ExportPovWithATruncatedTextureIsOneLine) {
+  const fs::path d = textured_scene_dir("export-trunc");
+  std::ofstream(d / "tex.png", std::ios::binary | std::ios::trunc) << "\x89PNG\r\n\x1a\n";
+  const auto r = run_rayaudit("export-pov " + (d / "s.json").string() + " -o " + (d / "x.pov").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind((d / "tex.png").string() + ": cannot read texture: ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(d / "x.pov"));
+}
+
 }  // namespace

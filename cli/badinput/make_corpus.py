@@ -224,3 +224,6 @@ V3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
 put("obj", "face_index_neg_2p63.obj", V3 + "f 1 2 -9223372036854775808\n")
 put("obj", "vt_index_neg_2p63.obj", V3 + "vt 0 0\nf 1/1 2/1 3/-9223372036854775808\n")
 put("obj", "vn_index_neg_2p63.obj", V3 + "vn 0 0 1\nf 1//1 2//1 3//-9223372036854775808\n")
+# texture/jpeg_truncated.jpg: the first 1000 bytes of `oiiotool --pattern
+# noise 128x128 3 -d uint8 -o n.jpg` (18 KB): read "successfully" with the
+# rest grey unless the reader's error state is checked (not regenerated here).

@@ -87,6 +87,13 @@ bool read(void* image, int channels, float* dst, std::string* err) try {
     *err = first_line(in->geterror());
     return false;
   }
+  // Some readers return true for a truncated file (a JPEG cut short, a PNG
+  // without IEND) and only record the error: such a texture was used with
+  // its missing part grey (issue 15's third pass).
+  if (in->has_error()) {
+    *err = first_line(in->geterror());
+    return false;
+  }
   return true;
 } catch (const std::exception& e) {
   *err = e.what();
