@@ -43,7 +43,7 @@ class ObjectReader {
   }
 
   [[noreturn]] void fail(const std::string& where, const std::string& what) const {
-    throw InputError(file_ + ": " + where + ": " + what);
+    throw InputError(located(file_, 0, where + ": " + what));  // control bytes in a key or path escaped
   }
   std::string at(const std::string& key) const { return path_ + "/" + key; }
   bool has(const std::string& key) {

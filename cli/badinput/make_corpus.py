@@ -227,3 +227,5 @@ put("obj", "vn_index_neg_2p63.obj", V3 + "vn 0 0 1\nf 1//1 2//1 3//-922337203685
 # texture/jpeg_truncated.jpg: the first 1000 bytes of `oiiotool --pattern
 # noise 128x128 3 -d uint8 -o n.jpg` (18 KB): read "successfully" with the
 # rest grey unless the reader's error state is checked (not regenerated here).
+put('texture', 'gif_absurd_size.gif', b'GIF89a\xff\xff\xff\xff\x00\x00\x00,\x00\x00\x00\x00\xff\xff\xff\xff\x00\x02\x02\x44\x01\x00;')
+put('scene', 'newline_in_key.json', '{"objects": [], "a\\nb": 1}\n')
