@@ -427,4 +427,31 @@ TEST(ReliabilityCli, ExportPovWithATruncatedTextureIsOneLine) {
   EXPECT_FALSE(fs::exists(d / "x.pov"));
 }
 
+// report: its audit input named as its report.json output is refused before
+// the script runs; stage times of nan, -5 or with a NUL are refused at their
+// line (they were drawn, or failed as a Python traceback).
+TEST(ReliabilityCli, ReportRefusesItsInputAsOutputAndBadStageTimes) {
+  const fs::path d = scratch("report-in-out");
+  fs::remove_all(d);
+  fs::create_directories(d / "rep");
+  const fs::path audit = d / "rep" / "report.json";
+  ASSERT_EQ(run_rayaudit("audit --rays 50 --families edge --methods moller --json " + audit.string()).code, 0);
+  const std::string before = slurp(audit);
+  auto r = run_rayaudit("report --audit " + audit.string() + " -o " + (d / "rep").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, audit.string() + ": is also an input of this command (" + audit.string() +
+                       "): it would be replaced; choose another output\n");
+  EXPECT_EQ(slurp(audit), before);
+  EXPECT_FALSE(fs::exists(d / "rep" / "index.html"));
+  for (const std::string& stage : {std::string("build\tnan\n"), std::string("build\t-5\n"), std::string("build\t1\0x\n", 10)}) {
+    std::ofstream(d / "st.tsv", std::ios::binary) << stage;
+    r = run_rayaudit("report --audit " + audit.string() + " --stages " + (d / "st.tsv").string() + " -o " +
+                     (d / "out").string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_EQ(r.err.rfind((d / "st.tsv").string() + ":1: ", 0), 0u) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "out"));
+}
+
 }  // namespace
