@@ -229,3 +229,7 @@ put("obj", "vn_index_neg_2p63.obj", V3 + "vn 0 0 1\nf 1//1 2//1 3//-922337203685
 # rest grey unless the reader's error state is checked (not regenerated here).
 put('texture', 'gif_absurd_size.gif', b'GIF89a\xff\xff\xff\xff\x00\x00\x00,\x00\x00\x00\x00\xff\xff\xff\xff\x00\x02\x02\x44\x01\x00;')
 put('scene', 'newline_in_key.json', '{"objects": [], "a\\nb": 1}\n')
+FACE1 = 'element face 1\nproperty list uchar int vertex_indices\nend_header\n'
+put('ply', 'version_2.ply', 'ply\nformat ascii 2.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1 + '0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'char_value_300.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty char x\nproperty char y\nproperty char z\n' + FACE1 + '0 0 0\n300 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'list_as_coordinate.ply', 'ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\nproperty float y\nproperty float z\nend_header\n1 5 0 0\n')
