@@ -71,7 +71,11 @@ void run_random(const Args& a) {
               << "/corpus (ci/fetch-corpus.sh): the scenes hold spheres, planes and triangles only\n";
   if (!a.out_dir.empty()) {
     std::error_code ec;
-    fs::create_directories(a.out_dir, ec);
+    // One level, as every other command's output directory: a missing
+    // parent is a mistyped path, not something to create (issue 15).
+    if (!fs::is_directory(fs::absolute(a.out_dir).parent_path()))
+      throw ra::InputError(a.out_dir + ": its parent directory does not exist");
+    fs::create_directory(a.out_dir, ec);
     if (ec || !fs::is_directory(a.out_dir)) throw ra::InputError(a.out_dir + ": cannot create the --out directory");
     ra::check_output_path(fs::path(a.out_dir) / "unexplained.json");
   }

@@ -454,4 +454,16 @@ TEST(ReliabilityCli, ReportRefusesItsInputAsOutputAndBadStageTimes) {
   EXPECT_FALSE(fs::exists(d / "out"));
 }
 
+// compare --random --out a/b/c created the missing parents; every other
+// command refuses an output whose parent directory does not exist.
+TEST(ReliabilityCli, CompareRandomOutWithAMissingParentIsRefused) {
+  const fs::path d = scratch("random-out");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const auto r = run_rayaudit("compare --random 1 --out " + (d / "a" / "b").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, (d / "a" / "b").string() + ": its parent directory does not exist\n");
+  EXPECT_FALSE(fs::exists(d / "a"));
+}
+
 }  // namespace
