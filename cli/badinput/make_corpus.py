@@ -234,3 +234,6 @@ put('ply', 'version_2.ply', 'ply\nformat ascii 2.0\nelement vertex 3\nproperty f
 put('ply', 'char_value_300.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty char x\nproperty char y\nproperty char z\n' + FACE1 + '0 0 0\n300 0 0\n0 1 0\n3 0 1 2\n')
 put('ply', 'list_as_coordinate.ply', 'ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\nproperty float y\nproperty float z\nend_header\n1 5 0 0\n')
 put('tolerance', 'pixel_listed_twice.json', '{"width": 8, "height": 8, "pixels": [{"x": 1, "y": 1, "levels": 1, "cause": "x"}, {"x": 1, "y": 1, "levels": 2, "cause": "y"}]}\n')
+put('scene', 'camera_1e308.json', '{"camera": {"position": [1e308, 0, 5]}, "objects": [{"sphere": {"radius": 1}}]}\n')
+put('scene', 'radius_denormal.json', '{"objects": [{"sphere": {"radius": 1e-320}}]}\n')
+put('scene', 'adc_bailout_negative.json', '{"adc_bailout": -1, "objects": [{"sphere": {"radius": 1}}]}\n')
