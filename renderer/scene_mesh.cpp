@@ -64,6 +64,10 @@ void check_mesh_format(const std::filesystem::path& file) {
   if (ext == ".ply" || ext == ".off")
     throw InputError(located(file.string(), 0, "a " + ext.substr(1) + " mesh: scenes take OBJ; convert it first "
                                                 "(rayaudit convert " + file.filename().string() + " -o NAME.obj)"));
+  // A scene (even the scene itself) named as a mesh read as an OBJ of
+  // unknown statements: warnings, and an empty mesh rendered (issue 15).
+  if (ext == ".json")
+    throw InputError(located(file.string(), 0, "a JSON file, not a mesh: a scene's \"mesh\" names an OBJ file"));
 }
 
 std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {

@@ -237,3 +237,4 @@ put('tolerance', 'pixel_listed_twice.json', '{"width": 8, "height": 8, "pixels":
 put('scene', 'camera_1e308.json', '{"camera": {"position": [1e308, 0, 5]}, "objects": [{"sphere": {"radius": 1}}]}\n')
 put('scene', 'radius_denormal.json', '{"objects": [{"sphere": {"radius": 1e-320}}]}\n')
 put('scene', 'adc_bailout_negative.json', '{"adc_bailout": -1, "objects": [{"sphere": {"radius": 1}}]}\n')
+put('scene', 'mesh_is_json.json', '{"objects": [{"mesh": "mesh_is_json.json"}]}\n')
