@@ -1,6 +1,7 @@
 // Tests of `rayaudit audit` run as a user would (cli/cmd_audit.cpp): exit
 // codes, the --cases JSON shape, malformed input, export round trip, determinism.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "run_rayaudit.h"
 
@@ -11,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -276,6 +278,47 @@ TEST(AuditShards, MergingShardsOfDifferentRunsIsAnErrorNamingBothFiles) {
   EXPECT_EQ(rayaudit(run + " --shard 1").code, 2);
 }
 
+// Hostile shards (issue 15's third pass): a count near 2^64 wrapped when
+// merged, a shard count of 4e9 was a bad_alloc, a key given twice was
+// resolved silently, a directory was a raw library error.
+TEST(AuditShards, HostileShardsAreOneLineErrors) {
+  const std::string run = "audit --methods moller --families edge --rays 200";
+  const fs::path a = tmp("h1.json"), b = tmp("h2.json"), out = tmp("hout.json");
+  ASSERT_EQ(rayaudit(run + " --shard 1/2 --json " + a.string()).code, 0);
+  ASSERT_EQ(rayaudit(run + " --shard 2/2 --json " + b.string()).code, 0);
+  auto one_error = [&](const fs::path& first, const fs::path& second, const std::string& says) {
+    const Result r = rayaudit("audit merge " + first.string() + " " + second.string() + " --json " + out.string());
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  };
+  auto jb = nlohmann::json::parse(slurp(b));
+  jb["cells"][0]["stats"]["tests"] = std::numeric_limits<std::uint64_t>::max();
+  const fs::path big = tmp("hbig.json");
+  write(big, jb.dump());
+  auto ja = nlohmann::json::parse(slurp(a));
+  ja["cells"][0]["stats"]["tests"] = 20;
+  const fs::path small = tmp("hsmall.json");
+  write(small, ja.dump());
+  one_error(small, big, big.string() + ": a count overflows 2^64-1 when merged");
+  auto huge = [&](const fs::path& from, const fs::path& to) {
+    auto j = nlohmann::json::parse(slurp(from));
+    j["shard"]["n"] = 4000000000ULL;
+    write(to, j.dump());
+  };
+  const fs::path ha = tmp("hna.json"), hb = tmp("hnb.json");
+  huge(a, ha);
+  huge(b, hb);
+  one_error(ha, hb, "audit merge: shard 3/4000000000 is missing");
+  const std::string text = slurp(a);
+  const fs::path dup = tmp("hdup.json");
+  write(dup, "{\"seed\": 1,\n" + text.substr(text.find('{') + 1));
+  one_error(dup, b, dup.string() + ":");
+  one_error(dup, b, "given twice in one object");
+  one_error(tmp(""), b, ": is a directory, not a file");
+}
+
 // -------------------------------------------------------- --grade ---
 // The repository's example: textbook Moller-Trumbore in Python (numpy), its
 // answers graded against exported cases. The exact oracle, not the script,
@@ -332,6 +375,28 @@ TEST(AuditGrade, BadAnswersExitTwoWithFileLineAndWriteNothing) {
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
   EXPECT_EQ(rayaudit("audit --grade " + answers.string()).code, 2) << "--grade needs --cases";
+}
+
+// Answers as spreadsheets save them: a UTF-8 BOM is dropped (it read
+// "missing column 'id'"); UTF-16 is named; a directory or FIFO as answers is
+// named, not read as "empty file" or waited on (issue 15's third pass).
+TEST(AuditGrade, AnswersEncodingAndNonFilesAreNamed) {
+  const fs::path cases = tmp("ge_cases.csv"), answers = tmp("ge_answers.csv"), json = tmp("ge.json");
+  write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\na,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
+  const std::string grade = "audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string();
+  write(answers, "\xEF\xBB\xBFid,hit,t\na,true,1\n");
+  Result r = rayaudit(grade);
+  EXPECT_EQ(r.code, 0) << r.err;
+  write(answers, std::string("\xFF\xFEi\0d\0", 6));
+  r = rayaudit(grade);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, answers.string() + ":1: the file is UTF-16 (or holds NUL bytes): save it as UTF-8 or ASCII\n");
+  fs::remove(answers);
+  ASSERT_EQ(::mkfifo(answers.c_str(), 0644), 0);
+  r = rayaudit(grade);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, answers.string() + ": is a FIFO, not a file\n");
+  fs::remove(answers);
 }
 
 // ------------------------------------------------- --cases memory ---

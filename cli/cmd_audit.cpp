@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -18,7 +19,10 @@
 #include "cases_csv.h"
 #include "command.h"
 #include "errors.h"
+#include "io/file_identity.h"
 #include "grade.h"
+#include "io/input_file.h"
+#include "io/json_input.h"
 #include "registry.h"
 
 namespace {
@@ -62,7 +66,7 @@ std::vector<const ra::Method*> chosen_methods(const std::string& list) {
       if (m.kind != ra::Kind::plane) out.push_back(&m);
     return out;
   }
-  for (const auto& name : split_list(list)) {
+  for (const auto& name : split_list(list, "--methods")) {
     const ra::Method* m = ra::find_method(name);
     if (!m)
       throw ra::InputError("audit: unknown method '" + name + "' (triangle: " +
@@ -77,7 +81,7 @@ std::vector<const ra::Method*> chosen_methods(const std::string& list) {
 
 std::vector<Precision> chosen_precisions(const std::string& list) {
   std::vector<Precision> out;
-  for (const auto& p : split_list(list)) {
+  for (const auto& p : split_list(list, "--precision")) {
     if (p == "float") out.push_back(Precision::f32);
     else if (p == "double") out.push_back(Precision::f64);
     else throw ra::InputError("audit: unknown precision '" + p + "' (float, double)");
@@ -87,7 +91,7 @@ std::vector<Precision> chosen_precisions(const std::string& list) {
 }
 
 std::vector<std::string> chosen_families(const std::string& list) {
-  const auto names = split_list(list);
+  const auto names = split_list(list, "--families");
   for (const auto& n : names)
     if (!find_family(n))
       throw ra::InputError("audit: unknown family '" + n + "' (" + family_names() + ")");
@@ -257,7 +261,7 @@ void export_cases(const Args& a) {
   if (a.rays > kMaxExportRays)
     throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
                          std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
-  ra::check_output_path(a.export_cases);
+  ra::declare_output(a.export_cases);
   const auto precisions = chosen_precisions(a.precision);
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
@@ -319,16 +323,17 @@ struct ShardFile {
 };
 
 ShardFile read_shard(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ra::InputError(ra::located(path, 0, "cannot open the shard's JSON"));
-  ShardFile f{path, nlohmann::json::parse(in, nullptr, false), {}};
-  if (f.json.is_discarded()) throw ra::InputError(ra::located(path, 0, "not JSON (an `audit --shard K/N --json` output?)"));
+  // read_json_file: a directory or FIFO named, not read or waited on; a
+  // syntax error at its line; a key given twice refused.
+  ShardFile f{path, ra::read_json_file(path), {}};
   if (!f.json.is_object() || !f.json.contains("shard"))
     throw ra::InputError(ra::located(path, 0, "not a shard's output (no \"shard\" key: run audit with --shard K/N)"));
   try {
     f.report = Report::from_json(f.json);
+  } catch (const ra::InputError&) {
+    throw;
   } catch (const std::exception& e) {
-    throw ra::InputError(ra::located(path, 0, e.what()));
+    throw ra::InputError(ra::located(path, 0, ra::json_error_text(e)));  // no "[json.exception...]" prefix
   }
   return f;
 }
@@ -353,34 +358,42 @@ void merge(const Args& a) {
   std::vector<ShardFile> files;
   for (const auto& p : a.merge_inputs) files.push_back(read_shard(p));
   const auto first = run_identity(files[0]);
-  std::vector<const ShardFile*> by_k(std::size_t(files[0].report.shard->n) + 1, nullptr);
+  // Shards by k in a map, not a table of n entries (n = 4e9 was a bad_alloc).
+  const std::uint64_t n = files[0].report.shard->n;
+  std::map<std::uint64_t, const ShardFile*> by_k;
   for (const ShardFile& f : files) {
     const auto id = run_identity(f);
     for (std::size_t i = 0; i < id.size(); ++i)
       if (id[i].second != first[i].second) {
         std::string mine = id[i].second, theirs = first[i].second;
         if (mine.size() > 60 || theirs.size() > 60) mine = theirs = "";  // the lists: just say they differ
-        throw ra::InputError("audit merge: " + f.path + " and " + files[0].path + " are shards of different runs: " +
-                             id[i].first + (mine.empty() ? " differ" : " " + mine + " vs " + theirs));
+        throw ra::InputError(ra::located("audit merge", 0, f.path + " and " + files[0].path +
+                                                               " are shards of different runs: " + id[i].first +
+                                                               (mine.empty() ? " differ" : " " + mine + " vs " + theirs)));
       }
-    const auto k = std::size_t(f.report.shard->k);
-    if (k < 1 || k >= by_k.size()) throw ra::InputError(ra::located(f.path, 0, "shard k out of range 1..n"));
-    if (by_k[k])
+    const std::uint64_t k = f.report.shard->k;
+    if (k < 1 || k > n) throw ra::InputError(ra::located(f.path, 0, "shard k out of range 1..n"));
+    if (by_k.count(k))
       throw ra::InputError("audit merge: " + f.path + " and " + by_k[k]->path + " are both shard " + std::to_string(k) +
-                           "/" + std::to_string(by_k.size() - 1));
+                           "/" + std::to_string(n));
     by_k[k] = &f;
   }
   if (files[0].json.value("version", "") != RAYAUDIT_VERSION)
     throw ra::InputError(ra::located(files[0].path, 0, "written by rayaudit " + files[0].json.value("version", "(unknown)") +
                                                          "; merge with that version (this is " + RAYAUDIT_VERSION + ")"));
-  for (std::size_t k = 1; k < by_k.size(); ++k)
-    if (!by_k[k])
-      throw ra::InputError("audit merge: shard " + std::to_string(k) + "/" + std::to_string(by_k.size() - 1) +
-                           " is missing (" + std::to_string(files.size()) + " file(s) given, the first " + files[0].path + ")");
+  // The first k missing (at most files + 1 steps, whatever n says).
+  for (std::uint64_t k = 1; k <= n; ++k)
+    if (!by_k.count(k))
+      throw ra::InputError("audit merge: shard " + std::to_string(k) + "/" + std::to_string(n) + " is missing (" +
+                           std::to_string(files.size()) + " file(s) given, the first " + files[0].path + ")");
   Report rep = files[0].report;
   rep.shard.reset();
   for (std::size_t i = 1; i < files.size(); ++i)
-    for (std::size_t c = 0; c < rep.cells.size(); ++c) rep.cells[c].stats.merge(files[i].report.cells[c].stats);
+    try {
+      for (std::size_t c = 0; c < rep.cells.size(); ++c) rep.cells[c].stats.merge(files[i].report.cells[c].stats);
+    } catch (const std::overflow_error& e) {
+      throw ra::InputError(ra::located(files[i].path, 0, e.what()));
+    }
   std::fputs(rep.summary_table().c_str(), stdout);
   ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
@@ -391,9 +404,11 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "audit", "Grade intersection methods against exact arithmetic (CGAL/GMP) on generated or given cases");
   auto a = std::make_shared<Args>();
-  cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)");
-  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str();
-  cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names());
+  cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)")
+      ->check(ra::cli::non_empty_list());
+  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
+  cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names())
+      ->check(ra::cli::non_empty_list());
   cmd->add_option("--rays", a->rays,
                   "Ray/primitive tests per family per method and precision (a ray against a fan of 6 counts 6)")
       ->capture_default_str()

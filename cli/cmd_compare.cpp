@@ -14,6 +14,7 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "memory_budget.h"
 #include "golden.h"
 #include "image_compare.h"
 #include "pov_explain.h"
@@ -70,7 +71,11 @@ void run_random(const Args& a) {
               << "/corpus (ci/fetch-corpus.sh): the scenes hold spheres, planes and triangles only\n";
   if (!a.out_dir.empty()) {
     std::error_code ec;
-    fs::create_directories(a.out_dir, ec);
+    // One level, as every other command's output directory: a missing
+    // parent is a mistyped path, not something to create (issue 15).
+    if (!fs::is_directory(fs::absolute(a.out_dir).parent_path()))
+      throw ra::InputError(a.out_dir + ": its parent directory does not exist");
+    fs::create_directory(a.out_dir, ec);
     if (ec || !fs::is_directory(a.out_dir)) throw ra::InputError(a.out_dir + ": cannot create the --out directory");
     ra::check_output_path(fs::path(a.out_dir) / "unexplained.json");
   }
@@ -145,6 +150,8 @@ void run(const Args& a) {
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
   if (a.height > 0) scene.height = a.height;
+  // Ours, POV-Ray's as read, the difference and their encodings.
+  ra::check_image_memory("compare", scene.width, scene.height, 64);
   if (auto reason = ra::pov_inexpressible(scene)) {
     if (a.skip_inexpressible) {
       std::cout << "skipped: POV-Ray cannot express " << a.scene << ": " << *reason << "\n";

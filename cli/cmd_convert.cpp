@@ -5,6 +5,7 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "io/file_identity.h"
 #include "formats/polymesh_io.h"
 
 namespace {
@@ -23,7 +24,7 @@ void setup(CLI::App& app) {
   cmd->callback([o] {
     const std::string out_ext = std::filesystem::path(o->out).extension().string();
     if (out_ext != ".obj" && out_ext != ".OBJ") throw ra::InputError(o->out + ": the output must be a .obj file");
-    ra::check_output_path(o->out);
+    ra::declare_output(o->out);  // reading the input refuses it if it is the output
     std::string fmt = o->from;
     if (fmt.empty()) {
       const std::string ext = std::filesystem::path(o->in).extension().string();

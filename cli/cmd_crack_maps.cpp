@@ -26,7 +26,7 @@ struct Args {
 
 std::vector<double> parse_offsets(const std::string& list) {
   std::vector<double> out;
-  for (const auto& s : split_list(list)) {
+  for (const auto& s : split_list(list, "--offsets")) {
     std::size_t used = 0;
     double v = 0;
     try {
@@ -39,6 +39,11 @@ std::vector<double> parse_offsets(const std::string& list) {
     out.push_back(v);
   }
   if (out.empty()) throw ra::InputError("--offsets: give at least one offset");
+  // Each offset is a map per mesh and method: 50k offsets ran for minutes.
+  constexpr std::size_t kMaxOffsets = 100;
+  if (out.size() > kMaxOffsets)
+    throw ra::InputError("--offsets: " + std::to_string(out.size()) + " offsets, more than the limit of " +
+                         std::to_string(kMaxOffsets));
   return out;
 }
 
@@ -72,7 +77,7 @@ void run(const Args& a) {
   opt.size = a.size;
   opt.threads = a.threads;
   opt.offsets = parse_offsets(a.offsets);
-  opt.methods = split_list(a.methods);
+  opt.methods = split_list(a.methods, "--methods");
   opt.progress = progress_count();
   const std::filesystem::path dir(a.out);
   if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))
@@ -89,12 +94,36 @@ void run(const Args& a) {
   }
   for (const auto& m : a.meshes) meshes.push_back(ra::crack::closed_obj(m));
 
-  const auto maps = ra::crack::render_maps(meshes, opt);  // throws on an unknown method, before writing
-
-  std::filesystem::create_directories(dir);
+  // Every output named and checked before the work (issue 15: a name too
+  // long failed after it, leaving one map; a --mesh named sphere.obj shared
+  // the built-in sphere's names and one of each pair was lost).
   std::vector<std::filesystem::path> outputs{dir / "crack_maps.json"};
-  for (const auto& m : maps) outputs.push_back(dir / (m.mesh + "-" + m.method + "-" + offset_label(m.offset) + ".png"));
+  const auto methods = ra::crack::map_methods(opt);  // throws on an unknown method
+  for (const auto& mesh : meshes)
+    for (const double offset : opt.offsets)
+      for (const auto& method : methods)
+        outputs.push_back(dir / (mesh.name + "-" + method + "-" + offset_label(offset) + ".png"));
+  for (std::size_t i = 1; i < outputs.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k)
+      if (outputs[k] == outputs[i])
+        throw ra::InputError(outputs[i].string() + ": two maps would have this name (meshes of one name, or "
+                             "offsets or methods given twice): rename the mesh or drop the repeat");
+  for (const auto& o : outputs) ra::check_output_name(o);
+  // The directory is made now and removed again if the run fails in it.
+  std::error_code ec;
+  const bool made_dir = !std::filesystem::exists(dir, ec);
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw ra::InputError(ra::located(a.out, 0, "cannot create the directory: " + ec.message()));
+  struct RemoveIfFailed {
+    std::filesystem::path dir;
+    bool armed;
+    ~RemoveIfFailed() {
+      std::error_code e;
+      if (armed) std::filesystem::remove(dir, e);  // only if empty: nothing of ours is left in it
+    }
+  } cleanup{dir, made_dir};
   ra::OutputBatch batch(outputs);
+  const auto maps = ra::crack::render_maps(meshes, opt);
   nlohmann::json j = {{"size", opt.size},
                       {"precision", "float"},
                       {"offsets", opt.offsets},
@@ -106,6 +135,7 @@ void run(const Args& a) {
     ms.push_back({{"name", m.name}, {"source", m.source}, {"triangles", m.faces.size()}});
   j["meshes"] = ms;
   std::printf("%-14s %-16s %10s %8s %8s %8s\n", "MESH", "METHOD", "OFFSET", "SURFACE", "LEAKS", "F.HITS");
+  if (maps.size() + 1 != outputs.size()) throw std::logic_error("crack-maps: maps and their names disagree");
   for (std::size_t i = 0; i < maps.size(); ++i) {
     const auto& m = maps[i];
     ra::write_image(outputs[i + 1], m.image);
@@ -124,6 +154,7 @@ void run(const Args& a) {
   j["maps"] = entries;
   ra::write_text_atomically(outputs[0], j.dump(1) + "\n");
   batch.commit();
+  cleanup.armed = false;
   std::cout << "wrote " << maps.size() << " maps and crack_maps.json into " << a.out << "\n";
 }
 
@@ -135,8 +166,10 @@ void setup(CLI::App& app) {
       ->required();
   cmd->add_option("--mesh", a->meshes,
                   "A closed OBJ to map besides the audit's sphere (default: the ladder's elephant_cgal.obj, 5,558 triangles)");
-  cmd->add_option("--offsets", a->offsets, "Comma-separated offsets of the mesh centre (o, o, o)")->capture_default_str();
-  cmd->add_option("--methods", a->methods, "Comma-separated triangle methods (default: all)");
+  cmd->add_option("--offsets", a->offsets, "Comma-separated offsets of the mesh centre (o, o, o)")
+      ->capture_default_str()
+      ->check(ra::cli::non_empty_list());
+  cmd->add_option("--methods", a->methods, "Comma-separated triangle methods (default: all)")->check(ra::cli::non_empty_list());
   cmd->add_option("--size", a->size, "Pixels a side")->capture_default_str();
   cmd->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   cmd->callback([a] { run(*a); });

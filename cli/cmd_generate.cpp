@@ -30,7 +30,9 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "io/file_identity.h"
 #include "image.h"
+#include "io/input_file.h"
 #include "formats/mesh.h"
 #include "vec.h"
 
@@ -40,6 +42,7 @@ using ra::Vec3d;
 using Patch = std::array<Vec3d, 16>;  // row-major: 4 rows of 4 control points
 
 std::vector<Patch> read_teapot_inc(const std::string& file) {
+  ra::check_input_file(file);  // /dev/zero, a FIFO or a directory named, not read
   std::ifstream in(file);
   if (!in) throw ra::InputError(ra::located(file, 0, "cannot open"));
   std::stringstream ss;
@@ -78,7 +81,7 @@ Vec3d eval_patch(const Patch& p, double u, double v) {
 }
 
 void generate_teapot(const std::string& inc, const std::string& out_path, int steps) {
-  ra::check_output_path(out_path);
+  ra::declare_output(out_path);
   const auto patches = read_teapot_inc(inc);
   std::vector<Vec3d> positions;
   std::map<std::array<long long, 3>, int> weld;

@@ -5,7 +5,9 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "io/file_identity.h"
 #include "image_module.h"
+#include "memory_budget.h"
 #include "registry.h"
 #include "render.h"
 #include "scene/scene.h"
@@ -82,7 +84,7 @@ void run(const Args& a) {
     if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR")
       throw ra::InputError(a.out + ": output must be .png or .exr");
     // Its directory too: a missing one used to be found after the render.
-    ra::check_output_path(a.out);
+    ra::declare_output(a.out);  // and not an input (the scene's textures are checked on loading)
     // And the image module that will write it (loaded now, not after the render).
     ra::image_module::api();
   }
@@ -91,6 +93,9 @@ void run(const Args& a) {
   if (a.height > 0) scene.height = a.height;
   if (a.width > 0 || a.height > 0) ra::apply_content_defaults(scene);
   check_work(scene, a.spp);
+  // The image (12 bytes a pixel) and its encoded copies (up to 6 + 6 at
+  // 16 bits), refused now rather than as a bad_alloc after the render.
+  ra::check_image_memory("render", scene.width, scene.height, 24);
   const ra::Image img = ra::render(scene, opt);
   ra::write_image(a.out, img, {a.bits, a.srgb});
 }

@@ -3,16 +3,20 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "io/input_file.h"
 #include "registry.h"
 
 namespace {
@@ -33,8 +37,7 @@ std::string python() {
 fs::path script() { return fs::path(RAYAUDIT_SOURCE_DIR) / "validation" / "report" / "report.py"; }
 
 std::string read_file(const fs::path& f) {
-  if (!fs::exists(f)) throw ra::InputError(f.string() + ": no such file");
-  if (!fs::is_regular_file(f)) throw ra::InputError(f.string() + ": not a regular file");
+  ra::check_input_file(f);  // what it is if not a file; an output naming it is refused
   std::ifstream in(f, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -194,9 +197,16 @@ void check_stages(const fs::path& f) {
     if (line.empty()) continue;
     const auto tab = line.rfind('\t');
     char* end = nullptr;
-    if (tab != std::string::npos) std::strtod(line.c_str() + tab + 1, &end);
-    if (tab == std::string::npos || tab == 0 || !end || *end != '\0' || end == line.c_str() + tab + 1)
+    double seconds = 0;
+    if (tab != std::string::npos) seconds = std::strtod(line.c_str() + tab + 1, &end);
+    // A NUL ends strtod's view early (the script then failed with a
+    // traceback): the whole field must be the number.
+    if (tab == std::string::npos || tab == 0 || !end || end != line.c_str() + line.size() ||
+        end == line.c_str() + tab + 1)
       throw ra::InputError(ra::located(f.string(), n, "expected STAGE<TAB>SECONDS"));
+    // nan, a negative time or 1e400 (inf) were drawn as given.
+    if (!std::isfinite(seconds) || seconds < 0)
+      throw ra::InputError(ra::located(f.string(), n, "seconds must be a finite number >= 0"));
   }
 }
 
@@ -216,6 +226,9 @@ int run_script(const fs::path& ctx) {
   if (pid < 0) throw std::runtime_error("report: cannot start " + python());
   if (pid == 0) {
     const std::string py = python(), sc = script().string(), c = ctx.string();
+    // Matplotlib's cache beside the context (a read-only home printed a
+    // warning line on stderr).
+    ::setenv("MPLCONFIGDIR", ctx.parent_path().c_str(), 1);
     execl(py.c_str(), py.c_str(), sc.c_str(), c.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
@@ -230,6 +243,8 @@ void run(const Args& a) {
   if (fs::exists(dir) && !fs::is_directory(dir)) throw ra::InputError(a.out + ": exists and is not a directory");
   if (!fs::is_directory(fs::absolute(dir).parent_path()))
     throw ra::InputError(a.out + ": its parent directory does not exist");
+  if (!fs::exists(dir) && ::access(fs::absolute(dir).parent_path().c_str(), W_OK) != 0)
+    throw ra::InputError(ra::located(a.out, 0, std::string("cannot create the directory: ") + std::strerror(errno)));
   check_audit(a.audit);
   if (!a.bench.empty()) check_bench(a.bench);
   for (const auto& d : a.compare) check_compare_dir(d);
@@ -239,6 +254,10 @@ void run(const Args& a) {
   if (access(python().c_str(), X_OK) != 0)
     throw ra::InputError(python() + ": not found (the report needs Debian's python3-matplotlib; ci/install-deps.sh)");
   if (!fs::is_regular_file(script())) throw ra::InputError(script().string() + ": the report script is missing");
+  // An existing directory's outputs are declared now: one that is an input
+  // (`--audit rep/report.json -o rep`) is refused before the script runs.
+  std::optional<ra::OutputBatch> early;
+  if (fs::is_directory(dir)) early.emplace(std::vector<fs::path>{dir / "index.html", dir / "report.json"});
 
   char tmpl[] = "/tmp/rayaudit-report-XXXXXX";
   if (!mkdtemp(tmpl)) throw std::runtime_error("report: cannot make a temporary directory");
@@ -271,11 +290,23 @@ void run(const Args& a) {
     throw std::runtime_error("report: " + script().string() + " failed (exit " + std::to_string(rc) + ")");
   const std::string page = read_file(tmp / "index.html"), data = read_file(tmp / "report.json");
 
-  fs::create_directories(dir);
-  ra::OutputBatch outputs({dir / "index.html", dir / "report.json"});
+  std::error_code ec;
+  const bool made_dir = !fs::exists(dir, ec);
+  fs::create_directories(dir, ec);
+  if (ec) throw ra::InputError(ra::located(a.out, 0, "cannot create the directory: " + ec.message()));
+  struct RemoveIfFailed {
+    fs::path dir;
+    bool armed;
+    ~RemoveIfFailed() {
+      std::error_code e;
+      if (armed) fs::remove(dir, e);  // only if empty: nothing of ours is left in it
+    }
+  } undo{dir, made_dir};
+  if (!early) early.emplace(std::vector<fs::path>{dir / "index.html", dir / "report.json"});
   ra::write_text_atomically(dir / "index.html", page);
   ra::write_text_atomically(dir / "report.json", data);
-  outputs.commit();
+  early->commit();
+  undo.armed = false;
   std::cout << "wrote " << (dir / "index.html").string() << " (" << page.size() / 1024 << " KiB) and "
             << (dir / "report.json").string() << "\n";
 }

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "errors.h"
+
 namespace ra::cli {
 
 // `setup` adds a subcommand to the app and its callback. The callback may
@@ -20,20 +22,32 @@ struct Command {
 
 std::vector<Command>& commands();
 
-// "a, b,,c" -> {"a", "b", "c"}: the comma-separated lists of options such
-// as --methods, --families and --offsets (spaces and empty items dropped).
-inline std::vector<std::string> split_list(const std::string& s) {
+// "a, b,c" -> {"a", "b", "c"}: the comma-separated lists of options such
+// as --methods, --families and --offsets (spaces dropped). An empty item
+// ("a,,b", "a,", ",") is an error naming `flag`: it was dropped silently,
+// and `--methods ,` meant every method (issue 15).
+inline std::vector<std::string> split_list(const std::string& s, const char* flag) {
   std::vector<std::string> out;
+  if (s.find_first_not_of(' ') == std::string::npos) return out;  // not given
   std::string cur;
   for (char ch : s + ",") {
     if (ch == ',') {
-      if (!cur.empty()) out.push_back(cur);
+      if (cur.empty()) throw ra::InputError(std::string(flag) + ": empty item in the list '" + s + "'");
+      out.push_back(cur);
       cur.clear();
     } else if (ch != ' ') {
       cur += ch;
     }
   }
   return out;
+}
+
+// A validator for list options: given, the list must not be empty (an
+// explicit `--families ''` meant every family).
+inline CLI::Validator non_empty_list() {
+  return CLI::Validator(
+      [](std::string& v) { return v.find_first_not_of(' ') == std::string::npos ? std::string("empty list") : std::string(); },
+      "LIST");
 }
 
 struct Registrar {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <string_view>
 
 #include "command.h"
@@ -61,6 +62,12 @@ int main(int argc, char** argv) {
     // every other input error, not the library's "filesystem error: status: ...".
     const std::string path = !e.path1().empty() ? e.path1().string() : "rayaudit";
     std::cerr << path << ": " << e.code().message() << "\n";
+    return 2;
+  } catch (const std::bad_alloc&) {
+    // An allocation the checks before did not foresee: one line that says
+    // what happened, not the library's "std::bad_alloc".
+    std::cerr << "rayaudit: not enough memory for this input (an allocation failed; free memory or raise "
+                 "`ulimit -v`, or give smaller sizes)\n";
     return 2;
   } catch (const std::exception& e) {
     // Anything else (a filesystem error, an allocation too large for this

@@ -250,4 +250,220 @@ TEST(ReliabilityCli, OutputThatIsAFifoIsRefusedNotReplaced) {
   fs::remove(fifo);
 }
 
+// A scene with a mesh and a texture in a fresh directory: its files are
+// the inputs the output tests below name as outputs.
+fs::path textured_scene_dir(const std::string& name) {
+  const fs::path d = scratch(name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  fs::copy_file(kScenes + "/meshes/quad.obj", d / "m.obj");
+  fs::copy_file(kScenes + "/textures/uv-grid.png", d / "tex.png");
+  std::ofstream(d / "s.json") << R"({"width": 8, "height": 8, "objects": [{"mesh": "m.obj", "material": {"texture": "tex.png"}}]})"
+                              << "\n";
+  return d;
+}
+
+// An output that is one of the command's inputs (the scene, the mesh or
+// texture it references, the cases CSV) is refused before the work: the
+// rename replaced the input (issue 15's second pass: `render s.json -o
+// tex.png`, `export-pov --ini s.json`, `audit --cases c.csv --json c.csv`).
+TEST(ReliabilityCli, OutputThatIsAnInputIsRefusedAndTheInputKept) {
+  const fs::path d = textured_scene_dir("out-is-input");
+  const fs::path cases = d / "c.csv";
+  ASSERT_EQ(run_rayaudit("audit --export-cases " + cases.string() + " --families edge --rays 10").code, 0);
+  fs::create_symlink(d / "tex.png", d / "link.png");
+  const std::string s = (d / "s.json").string();
+  struct Case {
+    std::string args;
+    fs::path input;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"render " + s + " -o " + (d / "tex.png").string(), d / "tex.png"},
+           {"render " + s + " -o " + (d / "link.png").string(), d / "tex.png"},
+           {"export-pov " + s + " -o " + (d / "x.pov").string() + " --ini " + s, d / "s.json"},
+           {"audit --cases " + cases.string() + " --methods moller --json " + cases.string(), cases}}) {
+    const std::string before = slurp(c.input);
+    const auto r = run_rayaudit(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find("is also an input of this command"), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(slurp(c.input), before) << "replaced by " << c.args;
+  }
+  EXPECT_FALSE(fs::exists(d / "x.pov"));
+  EXPECT_TRUE(fs::is_symlink(d / "link.png"));
+}
+
+// Two outputs of one command on one path: the later replaced the earlier
+// (`--json X --csv X`; an --ini named like the texture export-pov copies).
+TEST(ReliabilityCli, TwoOutputsOnOnePathAreRefused) {
+  const fs::path d = textured_scene_dir("two-outputs");
+  const std::string same = (d / "same").string();
+  for (const std::string& args : std::vector<std::string>{
+           "audit --rays 50 --families edge --methods moller --json " + same + " --csv " + same,
+           "export-pov " + (d / "s.json").string() + " -o " + (d / "x.pov").string() + " --ini " +
+               (d / "x-tex0.png").string()}) {
+    const auto r = run_rayaudit(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find("is named as two outputs of this command"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(same));
+  EXPECT_FALSE(fs::exists(d / "x.pov"));
+  EXPECT_FALSE(fs::exists(d / "x-tex0.png"));
+}
+
+// crack-maps names every map before the work: a --mesh named like the
+// built-in sphere would share its maps' names (one of each pair lost), and a
+// name longer than the file system takes failed after the work, leaving a
+// partial directory. Both are refused first, and no directory is left.
+TEST(ReliabilityCli, CrackMapsRefusesCollidingAndOverlongNamesBeforeTheWork) {
+  const fs::path d = scratch("crack-names");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  std::ofstream(d / "sphere.obj") << tetra;
+  const std::string long_stem(248, 'm');
+  std::ofstream(d / (long_stem + ".obj")) << tetra;
+  const std::string cm = (d / "cm").string();
+  const auto a = run_rayaudit("crack-maps -o " + cm + " --methods moller --offsets 1 --size 8 --mesh " +
+                              (d / "sphere.obj").string());
+  EXPECT_EQ(a.code, 2) << a.all;
+  EXPECT_TRUE(one_line(a.err)) << a.err;
+  EXPECT_NE(a.err.find("sphere-moller-1.png: two maps would have this name"), std::string::npos) << a.err;
+  const auto b = run_rayaudit("crack-maps -o " + cm + " --methods moller --offsets 1 --size 8 --mesh " +
+                              (d / (long_stem + ".obj")).string());
+  EXPECT_EQ(b.code, 2) << b.all;
+  EXPECT_TRUE(one_line(b.err)) << b.err;
+  EXPECT_NE(b.err.find("file name too long"), std::string::npos) << b.err;
+  EXPECT_FALSE(fs::exists(cm)) << "left behind";
+}
+
+// A cases header of 200k columns with a repeat at its end: the repeat search
+// compared all pairs (over 20 s). Under a 20 s CPU limit (a bound against
+// runaway, not a timing) it answers with the repeated column.
+TEST(ReliabilityCli, CasesHeaderOf200kColumnsIsCheckedInLinearTime) {
+  const fs::path csv = scratch("wide.csv");
+  {
+    std::ofstream out(csv);
+    out << "ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz";
+    for (int i = 0; i < 200000; ++i) out << ",c" << i;
+    out << ",c5\n";
+  }
+  const auto r = run_rayaudit("audit --cases " + csv.string() + " --methods moller", "prlimit --cpu=20 --");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, csv.string() + ":1: column 'c5' appears twice in the header\n");
+}
+
+// A golden manifest claiming 16384x16384 for an 8x8 golden: the golden's
+// size is compared first, not after a 3.3 GB render of the claimed size
+// (which a 1 GB address-space limit turns into a failed allocation).
+TEST(ReliabilityCli, GoldenSizeIsComparedBeforeRenderingTheManifestsSize) {
+  SKIP_IF_SANITIZED();
+  const fs::path root = scratch("golden-size");
+  fs::remove_all(root);
+  fs::create_directories(root / "scenes");
+  fs::create_directories(root / "golden");
+  std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}}]})"
+                                             << "\n";
+  ASSERT_EQ(run_rayaudit("golden bless t --root " + root.string()).code, 0);
+  std::string manifest = slurp(root / "golden" / "manifest.json");
+  for (const char* key : {"\"width\": ", "\"height\": "}) {
+    const auto at = manifest.find(key) + std::string(key).size();
+    manifest.replace(at, manifest.find_first_of(",\n", at) - at, "16384");
+  }
+  std::ofstream(root / "golden" / "manifest.json") << manifest;
+  const auto r = run_rayaudit("golden check --root " + root.string() + " --diff-dir " + (root / "d").string(),
+                              "prlimit --as=1000000000 --");
+  EXPECT_EQ(r.code, 1) << r.all;
+  EXPECT_NE(r.all.find("but the manifest says 16384x16384"), std::string::npos) << r.all;
+}
+
+// A render whose image buffers exceed the memory left is refused before
+// the work with its estimate (it died of a bare std::bad_alloc after 37 s).
+TEST(ReliabilityCli, RenderBeyondTheMemoryLimitIsRefusedWithAnEstimate) {
+  SKIP_IF_SANITIZED();
+  const fs::path out = scratch("huge.png");
+  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 -o " +
+                                  out.string(),
+                              "prlimit --as=2000000000 --");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind("render: 16384x16384 needs about 6144 MB for its image buffers, but only ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// An empty item in a list option was dropped (`--offsets 1,,2`), and an
+// empty list meant "all" (`--methods ''`, `--families ,`): both refused.
+TEST(ReliabilityCli, ListOptionsWithAnEmptyItemAreRefused) {
+  const fs::path out = scratch("list.json");
+  struct Case {
+    std::string args, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"audit --rays 5 --families edge,,vertex --json " + out.string(), "--families: empty item in the list 'edge,,vertex'"},
+           {"audit --rays 5 --families , --json " + out.string(), "--families: empty item in the list ','"},
+           {"audit --rays 5 --methods moller, --json " + out.string(), "--methods: empty item in the list 'moller,'"},
+           {"audit --rays 5 --precision float, --json " + out.string(), "--precision: empty item in the list 'float,'"},
+           {"audit --rays 5 --methods '' --json " + out.string(), "--methods: empty list"},
+           {"crack-maps -o " + scratch("cm-list").string() + " --offsets 1,,2", "--offsets: empty item in the list '1,,2'"}}) {
+    const auto r = run_rayaudit(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(scratch("cm-list")));
+}
+
+// export-pov copies a scene's texture: a truncated PNG printed libpng's own
+// lines (3-4 on stderr, the first naming no file) before the error.
+TEST(ReliabilityCli, ExportPovWithATruncatedTextureIsOneLine) {
+  const fs::path d = textured_scene_dir("export-trunc");
+  std::ofstream(d / "tex.png", std::ios::binary | std::ios::trunc) << "\x89PNG\r\n\x1a\n";
+  const auto r = run_rayaudit("export-pov " + (d / "s.json").string() + " -o " + (d / "x.pov").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind((d / "tex.png").string() + ": cannot read texture: ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(d / "x.pov"));
+}
+
+// report: its audit input named as its report.json output is refused before
+// the script runs; stage times of nan, -5 or with a NUL are refused at their
+// line (they were drawn, or failed as a Python traceback).
+TEST(ReliabilityCli, ReportRefusesItsInputAsOutputAndBadStageTimes) {
+  const fs::path d = scratch("report-in-out");
+  fs::remove_all(d);
+  fs::create_directories(d / "rep");
+  const fs::path audit = d / "rep" / "report.json";
+  ASSERT_EQ(run_rayaudit("audit --rays 50 --families edge --methods moller --json " + audit.string()).code, 0);
+  const std::string before = slurp(audit);
+  auto r = run_rayaudit("report --audit " + audit.string() + " -o " + (d / "rep").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, audit.string() + ": is also an input of this command (" + audit.string() +
+                       "): it would be replaced; choose another output\n");
+  EXPECT_EQ(slurp(audit), before);
+  EXPECT_FALSE(fs::exists(d / "rep" / "index.html"));
+  for (const std::string& stage : {std::string("build\tnan\n"), std::string("build\t-5\n"), std::string("build\t1\0x\n", 10)}) {
+    std::ofstream(d / "st.tsv", std::ios::binary) << stage;
+    r = run_rayaudit("report --audit " + audit.string() + " --stages " + (d / "st.tsv").string() + " -o " +
+                     (d / "out").string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_EQ(r.err.rfind((d / "st.tsv").string() + ":1: ", 0), 0u) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "out"));
+}
+
+// compare --random --out a/b/c created the missing parents; every other
+// command refuses an output whose parent directory does not exist.
+TEST(ReliabilityCli, CompareRandomOutWithAMissingParentIsRefused) {
+  const fs::path d = scratch("random-out");
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const auto r = run_rayaudit("compare --random 1 --out " + (d / "a" / "b").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, (d / "a" / "b").string() + ": its parent directory does not exist\n");
+  EXPECT_FALSE(fs::exists(d / "a"));
+}
+
 }  // namespace

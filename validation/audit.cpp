@@ -86,19 +86,23 @@ template <std::size_t N> int median_bin(const std::array<std::uint64_t, N>& h, s
 }  // namespace
 
 void Stats::merge(const Stats& o) {
-  tests += o.tests, true_hits += o.true_hits, false_hits += o.false_hits;
-  true_misses += o.true_misses, false_misses += o.false_misses;
-  boundary_hits += o.boundary_hits, boundary_misses += o.boundary_misses;
-  coplanar_hits += o.coplanar_hits, coplanar_misses += o.coplanar_misses;
-  degenerate_hits += o.degenerate_hits, degenerate_misses += o.degenerate_misses;
-  nan_inf += o.nan_inf, wrong_t += o.wrong_t;
-  groups += o.groups, leaks += o.leaks, double_hits += o.double_hits;
-  spawned += o.spawned, self_hits += o.self_hits;
-  t_samples += o.t_samples;
+  // Checked: counts read from shard files could wrap (2^64-1 + 20 became 19).
+  auto add = [](std::uint64_t& a, std::uint64_t b) {
+    if (__builtin_add_overflow(a, b, &a)) throw std::overflow_error("a count overflows 2^64-1 when merged");
+  };
+  add(tests, o.tests), add(true_hits, o.true_hits), add(false_hits, o.false_hits);
+  add(true_misses, o.true_misses), add(false_misses, o.false_misses);
+  add(boundary_hits, o.boundary_hits), add(boundary_misses, o.boundary_misses);
+  add(coplanar_hits, o.coplanar_hits), add(coplanar_misses, o.coplanar_misses);
+  add(degenerate_hits, o.degenerate_hits), add(degenerate_misses, o.degenerate_misses);
+  add(nan_inf, o.nan_inf), add(wrong_t, o.wrong_t);
+  add(groups, o.groups), add(leaks, o.leaks), add(double_hits, o.double_hits);
+  add(spawned, o.spawned), add(self_hits, o.self_hits);
+  add(t_samples, o.t_samples);
   max_ulps = std::max(max_ulps, o.max_ulps);
   max_rel = std::max(max_rel, o.max_rel);
-  for (int i = 0; i < kUlpBins; ++i) ulp_hist[i] += o.ulp_hist[i];
-  for (int i = 0; i < kRelBins; ++i) rel_hist[i] += o.rel_hist[i];
+  for (int i = 0; i < kUlpBins; ++i) add(ulp_hist[i], o.ulp_hist[i]);
+  for (int i = 0; i < kRelBins; ++i) add(rel_hist[i], o.rel_hist[i]);
 }
 
 std::uint64_t Stats::median_ulps() const {

@@ -51,6 +51,11 @@ std::vector<ExportRow> export_rows(const std::vector<std::string>& families, Pre
 // The fields of one CSV line split at `sep`, each trimmed of spaces and tabs
 // (shared by the cases and the graded answers readers).
 std::vector<std::string> split_fields(const std::string& line, char sep = ',');
+
+// The header line as UTF-8 text: a UTF-8 byte-order mark is dropped; UTF-16
+// (a BOM or NUL bytes) is refused by name (InputError FILE:LINE), not
+// reported as a missing column. Shared by the cases and answers readers.
+void check_header_encoding(const std::string& path, long lineno, std::string& line);
 // True if the whole field is one number (decimal or hex float) that does not
 // overflow; underflow to a subnormal is accepted.
 bool parse_double(const std::string& s, double& out);

@@ -183,6 +183,12 @@ ClosedMesh closed_obj(const std::filesystem::path& file) {
   return m;
 }
 
+std::vector<std::string> map_methods(const Options& opt) {
+  std::vector<std::string> out;
+  for (const Method* m : chosen(opt.methods)) out.emplace_back(m->name);
+  return out;
+}
+
 std::vector<Map> render_maps(const std::vector<ClosedMesh>& meshes, const Options& opt) {
   const auto ms = chosen(opt.methods);
   const std::size_t total = meshes.size() * opt.offsets.size();

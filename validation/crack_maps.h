@@ -50,4 +50,8 @@ struct Map {
 // float-rounded ray against the float-rounded triangles, as the method sees them.
 std::vector<Map> render_maps(const std::vector<ClosedMesh>& meshes, const Options& opt);
 
+// The methods render_maps() uses for opt.methods, in its order (InputError
+// for an unknown name): lets a command name every output before the work.
+std::vector<std::string> map_methods(const Options& opt);
+
 }  // namespace ra::crack

@@ -12,6 +12,7 @@
 
 #include "cases_csv.h"
 #include "errors.h"
+#include "io/input_file.h"
 
 namespace ra::audit {
 
@@ -30,6 +31,7 @@ struct Given {
 };
 
 std::unordered_map<std::string, Given> read_answers(const std::string& path) {
+  check_input_file(path);  // a directory, FIFO or /dev/zero named, not read
   std::ifstream in(path);
   if (!in) throw InputError(located(path, 0, "cannot open the answers file"));
   std::string line;
@@ -38,6 +40,7 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
   while (header.empty() && std::getline(in, line)) {
     ++lineno;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    check_header_encoding(path, lineno, line);  // a BOM dropped, UTF-16 named (was "missing column 'id'")
     if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
   }
   if (header.empty()) throw InputError(located(path, lineno, "empty file: expected a header line id,hit,t"));

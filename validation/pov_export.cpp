@@ -7,6 +7,7 @@
 
 #include "io/atomic_file.h"
 #include "errors.h"
+#include "image.h"
 #include "image_module.h"
 
 namespace ra {
@@ -248,6 +249,13 @@ PovExport export_pov(const Scene& scene, const std::string& image_prefix) {
 void copy_pov_image(const std::filesystem::path& source, const std::filesystem::path& dest) {
   // Encoded in memory, then written with every write and close checked:
   // OIIO's PNG writer does not report a full disk (issue 15).
+  // Read first as a texture is: its header size bounded by the file, a
+  // truncated file an error of one line (libpng's own lines kept off
+  // stderr), before the module's copy trusts it (issue 15's third pass).
+  {
+    int w = 0, h = 0, nc = 0;
+    read_pixels(source, "texture", w, h, nc);
+  }
   std::vector<unsigned char> png;
   std::string err;
   switch (image_module::api().rgb_png(source.c_str(), &png, &err)) {

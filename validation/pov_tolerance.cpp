@@ -46,6 +46,7 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
     if (t.max_levels_16 < 0 || t.max_levels_16 > 16)
       throw InputError(file.string() + ": /max_levels_16: must be 0..16 (POV's float32 colours give 2)");
     const auto pixels = j.value("pixels", nlohmann::json::array());
+    std::map<std::pair<int, int>, std::size_t> first_at;
     for (std::size_t i = 0; i < pixels.size(); ++i) {
       const auto& p = pixels[i];
       const std::string at = file.string() + ": /pixels/" + std::to_string(i);
@@ -69,6 +70,10 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
                        p.at("cause").get<std::string>()};
       if (e.levels < 1 || e.levels > 255) throw InputError(at + "/levels: must be 1..255");
       if (e.cause.empty()) throw InputError(at + ": every listed pixel needs its cause");
+      // A pixel listed twice was accepted, the later entry silently winning.
+      if (const auto [it, fresh] = first_at.try_emplace({e.x, e.y}, i); !fresh)
+        throw InputError(located(at, 0, "pixel (" + std::to_string(e.x) + ", " + std::to_string(e.y) +
+                                            ") listed twice (first at /pixels/" + std::to_string(it->second) + ")"));
       t.pixels.push_back(e);
     }
   } catch (const nlohmann::json::exception& e) {

@@ -217,3 +217,24 @@ put('mtl', 'map_kd_directory.mtl', 'newmtl a\nmap_Kd ../texture/is_a_directory.p
 loop = os.path.join(HERE, 'texture', 'symlink_loop.png')
 if not os.path.islink(loop):
     os.symlink('symlink_loop.png', loop)
+
+# Third pass (issue 15): -2^63 as a relative index (its negation overflowed,
+# and the index read before the first vertex).
+V3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+put("obj", "face_index_neg_2p63.obj", V3 + "f 1 2 -9223372036854775808\n")
+put("obj", "vt_index_neg_2p63.obj", V3 + "vt 0 0\nf 1/1 2/1 3/-9223372036854775808\n")
+put("obj", "vn_index_neg_2p63.obj", V3 + "vn 0 0 1\nf 1//1 2//1 3//-9223372036854775808\n")
+# texture/jpeg_truncated.jpg: the first 1000 bytes of `oiiotool --pattern
+# noise 128x128 3 -d uint8 -o n.jpg` (18 KB): read "successfully" with the
+# rest grey unless the reader's error state is checked (not regenerated here).
+put('texture', 'gif_absurd_size.gif', b'GIF89a\xff\xff\xff\xff\x00\x00\x00,\x00\x00\x00\x00\xff\xff\xff\xff\x00\x02\x02\x44\x01\x00;')
+put('scene', 'newline_in_key.json', '{"objects": [], "a\\nb": 1}\n')
+FACE1 = 'element face 1\nproperty list uchar int vertex_indices\nend_header\n'
+put('ply', 'version_2.ply', 'ply\nformat ascii 2.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1 + '0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'char_value_300.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty char x\nproperty char y\nproperty char z\n' + FACE1 + '0 0 0\n300 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'list_as_coordinate.ply', 'ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\nproperty float y\nproperty float z\nend_header\n1 5 0 0\n')
+put('tolerance', 'pixel_listed_twice.json', '{"width": 8, "height": 8, "pixels": [{"x": 1, "y": 1, "levels": 1, "cause": "x"}, {"x": 1, "y": 1, "levels": 2, "cause": "y"}]}\n')
+put('scene', 'camera_1e308.json', '{"camera": {"position": [1e308, 0, 5]}, "objects": [{"sphere": {"radius": 1}}]}\n')
+put('scene', 'radius_denormal.json', '{"objects": [{"sphere": {"radius": 1e-320}}]}\n')
+put('scene', 'adc_bailout_negative.json', '{"adc_bailout": -1, "objects": [{"sphere": {"radius": 1}}]}\n')
+put('scene', 'mesh_is_json.json', '{"objects": [{"mesh": "mesh_is_json.json"}]}\n')

@@ -17,7 +17,7 @@
 #include <cstring>
 #include <random>
 
-#include "render.h"
+#include "../render.h"
 
 namespace ra {
 namespace {

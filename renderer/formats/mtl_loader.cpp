@@ -18,6 +18,7 @@
 #include <cstring>
 
 #include "mesh.h"
+#include "../io/file_identity.h"
 #include "../io/input_file.h"
 #include "obj_text.h"
 
@@ -135,6 +136,8 @@ struct MtlParser {
       warnings.push_back(located(name, line, "texture '" + file + "' not found (" + dst + ")"));
     else if (!why.empty())
       w.fail(line, "texture '" + file + "': " + why + " (" + dst + ")");
+    else
+      note_input(path);  // never replaced by an output
   }
 
   void statement(const char* p, const char* se, long line) {

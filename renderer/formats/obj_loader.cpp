@@ -115,6 +115,14 @@ struct NameTable {
   }
 };
 
+// Distinct unsupported keywords warned one line each; the rest in one line.
+constexpr std::size_t kMaxKeywordWarnings = 10;
+
+// A keyword quoted in a warning: at most 40 bytes of it.
+std::string short_quote(const std::string& s) {
+  return s.size() > 40 ? s.substr(0, 40) + "... (" + std::to_string(s.size()) + " bytes)" : s;
+}
+
 struct Unknown {
   std::string keyword;
   long first_line;
@@ -146,6 +154,7 @@ struct Chunk {
   long vp = 0, l = 0, p = 0;
   std::vector<std::pair<long, std::string>> mtllibs;
   std::vector<Unknown> unknown;
+  std::unordered_map<std::string, std::size_t> unknown_at;  // keyword -> index: linear in distinct ones
   long mixed = 0, mixed_first_line = 0;
   // parallel: polygons (n > 3) whose n-2 triangle slots are filled in step 2,
   // when every chunk's positions are in place
@@ -666,7 +675,9 @@ struct ChunkParser {
       if (i > count) past_the_end(kind, i, count, se, line);
       out = int(i - 1);
     } else {
-      if (-i > count)
+      // i < -count, not -i > count: -i overflows for i = -2^63 (which
+      // then passed and read before the first vertex; issue 15).
+      if (i < -static_cast<long long>(count))
         w.fail(line, std::string("relative ") + kind + " index " + std::to_string(i) +
                          " reaches before the first one (" + std::to_string(count) + " defined before this face)");
       out = int(count + i);
@@ -709,6 +720,9 @@ struct ChunkParser {
     for (;;) {
       p = skip_ws(p, se);
       if (p >= se || *p == '#') break;
+      if (poly.size() == size_t(kMaxPolygonCorners))
+        w.fail(line, "face of more than " + std::to_string(kMaxPolygonCorners) +
+                         " corners (the limit a polygon; split it)");
       poly.push_back({-1, -1, -1});  // parsed in place (no copy of a temporary)
       Corner& k = poly.back();
       p = parse_index(p, se, nv, "vertex", line, k.v);
@@ -864,13 +878,12 @@ struct ChunkParser {
   }
 
   void unknown(const char* k, const char* kend, long line) {
-    const std::string_view kw(k, size_t(kend - k));
-    for (auto& u : c.unknown)
-      if (u.keyword == kw) {
-        ++u.count;
-        return;
-      }
-    c.unknown.push_back({std::string(kw), line, 1});
+    // A map, not a scan of those seen: 100k distinct unknown keywords
+    // took over 20 s (issue 15).
+    std::string kw(k, size_t(kend - k));
+    const auto [it, fresh] = c.unknown_at.try_emplace(kw, c.unknown.size());
+    if (fresh) c.unknown.push_back({std::move(kw), line, 1});
+    else ++c.unknown[it->second].count;
   }
 };
 
@@ -1063,6 +1076,7 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
   NameTable mats, groups, objects;
   int s_mat = -1, s_group = -1, s_object = -1, s_smooth = 0;
   std::vector<Unknown> unknown;
+  std::unordered_map<std::string, std::size_t> unknown_at;
   long mixed = 0, mixed_line = 0;
   std::vector<std::pair<long, std::string>> mtllibs;
   for (auto& c : chunks) {
@@ -1092,11 +1106,9 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
     m.skipped.p += c.p;
     mtllibs.insert(mtllibs.end(), c.mtllibs.begin(), c.mtllibs.end());
     for (auto& u : c.unknown) {
-      auto it = std::find_if(unknown.begin(), unknown.end(), [&](auto& x) { return x.keyword == u.keyword; });
-      if (it == unknown.end())
-        unknown.push_back(u);
-      else
-        it->count += u.count;
+      const auto [it, fresh] = unknown_at.try_emplace(u.keyword, unknown.size());
+      if (fresh) unknown.push_back(u);
+      else unknown[it->second].count += u.count;
     }
     if (c.mixed && mixed == 0) mixed_line = c.mixed_first_line;
     mixed += c.mixed;
@@ -1111,10 +1123,22 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
   }
   m.groups = std::move(groups.names);
   m.objects = std::move(objects.names);
-  for (auto& u : unknown)
+  // The first kMaxKeywordWarnings keywords one line each, the rest in one
+  // line: 100k distinct ones printed 100k warnings.
+  for (std::size_t i = 0; i < unknown.size() && i < kMaxKeywordWarnings; ++i) {
+    const Unknown& u = unknown[i];
     m.warnings.push_back(located(m.path, u.first_line,
-                                 "unsupported statement '" + u.keyword + "' ignored (" + std::to_string(u.count) +
-                                     (u.count == 1 ? " line)" : " lines)")));
+                                 "unsupported statement '" + short_quote(u.keyword) + "' ignored (" +
+                                     std::to_string(u.count) + (u.count == 1 ? " line)" : " lines)")));
+  }
+  if (unknown.size() > kMaxKeywordWarnings) {
+    long lines = 0;
+    for (std::size_t i = kMaxKeywordWarnings; i < unknown.size(); ++i) lines += unknown[i].count;
+    m.warnings.push_back(located(m.path, unknown[kMaxKeywordWarnings].first_line,
+                                 std::to_string(unknown.size() - kMaxKeywordWarnings) +
+                                     " more unsupported keywords ignored (" + std::to_string(lines) +
+                                     (lines == 1 ? " line)" : " lines)")));
+  }
   if (mixed)
     m.warnings.push_back(located(m.path, mixed_line,
                                  "face mixes vertex forms (v, v/vt, v//vn, v/vt/vn); texture or normal indices "

@@ -103,6 +103,20 @@ bool ply_type(std::string_view s, PlyType& t) {
     if (s == n) return t = v, true;
   return false;
 }
+// ASCII values must fit their declared type (a char of 300 was taken as
+// 300): false for a value outside it, or a fraction in an integer type.
+bool fits_ply_type(PlyType t, double v) {
+  switch (t) {
+    case PlyType::I8: return v >= -128 && v <= 127 && v == std::floor(v);
+    case PlyType::U8: return v >= 0 && v <= 255 && v == std::floor(v);
+    case PlyType::I16: return v >= -32768 && v <= 32767 && v == std::floor(v);
+    case PlyType::U16: return v >= 0 && v <= 65535 && v == std::floor(v);
+    case PlyType::I32: return v >= -2147483648.0 && v <= 2147483647.0 && v == std::floor(v);
+    case PlyType::U32: return v >= 0 && v <= 4294967295.0 && v == std::floor(v);
+    default: return true;  // float, double: any number the reader accepted
+  }
+}
+
 int ply_size(PlyType t) {
   switch (t) {
     case PlyType::I8: case PlyType::U8: return 1;
@@ -182,6 +196,10 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       const auto f = t.word();
       format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
       if (format < 0) t.fail("unknown PLY format '" + std::string(f) + "'");
+      // Only version 1.0 exists: "2.0" was read as if it were 1.0.
+      if (t.at_eol()) t.fail("format line without a version (format " + std::string(f) + " 1.0)");
+      const auto version = t.word();
+      if (version != "1.0" && version != "1") t.fail("PLY version '" + std::string(version) + "' (only 1.0 is known)");
       t.next_line();
     } else if (k == "comment" || k == "obj_info") {
       t.next_line();
@@ -236,6 +254,8 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       if (el.props[i].list && (n == "vertex_indices" || n == "vertex_index")) ilist = int(i);
     }
     if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) t.fail("vertex element without x, y, z");
+    for (int c : {ix, iy, iz})  // a list named x read its count as the coordinate
+      if (is_vertex && el.props[size_t(c)].list) t.fail("vertex property '" + el.props[size_t(c)].name + "' is a list");
     if (is_face && ilist < 0) t.fail("face element without vertex_indices");
     // Reserve no more than the data can hold (a count alone is not trusted).
     if (is_vertex) m.positions.reserve(std::min(size_t(el.count), size_t(br.e - br.p) / min_row_bytes(el, format) + 1));
@@ -243,15 +263,21 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       Vec3d pos;
       for (size_t i = 0; i < el.props.size(); ++i) {
         const auto& pr = el.props[i];
-        auto value = [&](PlyType ty) { return format == 0 ? t.number<double>("PLY value") : br.get(ty); };
+        auto value = [&](PlyType ty, bool checked = true) {  // a list count has its own message
+          if (format != 0) return br.get(ty);
+          const double v = t.number<double>("PLY value");
+          if (checked && !fits_ply_type(ty, v)) t.fail("value " + number_text(v) + " does not fit the property's type");
+          return v;
+        };
         // Binary data has no lines: its errors name the byte offset.
         auto fail = [&](const std::string& what) {
           if (format == 0) t.fail(what);
           throw InputError(located(name, 0, "byte " + std::to_string(br.p - br.b) + ": " + what));
         };
         if (pr.list) {
-          const double c = value(pr.count_type);
-          if (!(c >= 0 && c <= 1e6) || c != double(long(c))) fail("bad list count " + number_text(c));
+          const double c = value(pr.count_type, false);
+          if (!(c >= 0 && c <= 1e6) || c != double(long(c)) || !fits_ply_type(pr.count_type, c))
+            fail("bad list count " + number_text(c));
           for (long j = 0; j < long(c); ++j) {
             const double v = value(pr.type);
             if (int(i) == ilist) {

@@ -28,6 +28,11 @@ namespace ra {
 
 inline constexpr long kEarClipWorkPerCorner = 200;
 
+// Readers refuse a polygon of more corners (FILE:LINE): its triangulation
+// holds about 130 bytes a corner (a 20 MB face of 9M corners needed 1.2 GB
+// and 200 steps a corner; issue 15). No real mesh comes near it.
+inline constexpr int kMaxPolygonCorners = 1000000;  // as PLY and OFF face sizes
+
 struct EarClipScratch {
   std::vector<int> next, prev, reflex, cell_start, cell_items;
   std::vector<char> alive;

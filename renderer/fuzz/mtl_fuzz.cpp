@@ -2,7 +2,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "errors.h"
+#include "../errors.h"
 #include "../formats/mesh.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

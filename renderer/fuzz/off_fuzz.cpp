@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "errors.h"
+#include "../errors.h"
 #include "../formats/polymesh_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

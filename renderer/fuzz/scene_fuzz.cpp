@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "errors.h"
+#include "../errors.h"
 #include "../scene/scene.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

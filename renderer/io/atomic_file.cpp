@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <climits>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <system_error>
 
 #include "../errors.h"
+#include "file_identity.h"
 
 namespace ra {
 
@@ -72,12 +74,24 @@ void write_atomically(const std::filesystem::path& path,
   }
 }
 
+void check_output_name(const std::filesystem::path& path) {
+  const std::size_t n = path.filename().string().size();
+  if (n > NAME_MAX)
+    throw InputError(located(path.string(), 0, "file name too long (" + std::to_string(n) + " bytes; at most " +
+                                                   std::to_string(NAME_MAX) + ")"));
+}
+
 void check_output_path(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
-  if (!fs::is_directory(dir, ec))
+  check_output_name(path);
+  if (!fs::is_directory(dir, ec)) {
+    // A symlink loop or an unreadable parent is not "does not exist".
+    if (ec && ec != std::errc::no_such_file_or_directory)
+      throw InputError(located(path.string(), 0, "output directory: " + ec.message()));
     throw InputError(located(path.string(), 0, "output directory does not exist"));
+  }
   // An existing output that is not a regular file is refused: the renamed
   // temporary would replace it (run as root, -o /dev/full turned the device
   // into a file; issue 15's second pass).
@@ -107,8 +121,9 @@ OutputBatch::OutputBatch(const std::vector<std::filesystem::path>& outputs) : ou
 }
 
 void OutputBatch::add(const std::filesystem::path& output) {
-  check_output_path(output);
+  declare_output(output);  // not an input, not another output's path
   outputs_.push_back(key(output));
+  declared_.push_back(output);
 }
 
 bool OutputBatch::stage(const std::filesystem::path& path, const std::filesystem::path& tmp) {
@@ -141,6 +156,7 @@ void OutputBatch::commit() {
 OutputBatch::~OutputBatch() {
   std::error_code ec;
   for (const auto& s : staged_) std::filesystem::remove(s.first, ec);
+  for (const auto& d : declared_) undeclare_output(d);
   g_batch = outer_;
 }
 

@@ -30,6 +30,11 @@ void write_bytes_checked(const std::filesystem::path& file, const void* data, st
 // before doing any work, so a bad path costs nothing.
 void check_output_path(const std::filesystem::path& path);
 
+// Throws InputError `PATH: file name too long` when the last component is
+// longer than the file system takes (NAME_MAX): said before the work, not as
+// "cannot write: Success" after it. check_output_path() calls it.
+void check_output_name(const std::filesystem::path& path);
+
 // A command with several outputs writes all of them or none. While a batch is
 // alive, write_atomically() to one of its outputs leaves the finished
 // temporary file in place; commit() renames them all; a batch destroyed
@@ -37,7 +42,8 @@ void check_output_path(const std::filesystem::path& path);
 // batch does not list (e.g. POV-Ray's scratch files) are not deferred.
 class OutputBatch {
  public:
-  // Checks each non-empty path with check_output_path().
+  // Checks each non-empty path with declare_output() (file_identity.h): an
+  // input or a path given twice is refused.
   explicit OutputBatch(const std::vector<std::filesystem::path>& outputs);
   ~OutputBatch();
   OutputBatch(const OutputBatch&) = delete;
@@ -51,6 +57,7 @@ class OutputBatch {
 
  private:
   std::vector<std::filesystem::path> outputs_;  // absolute, normalised
+  std::vector<std::filesystem::path> declared_;  // as given to declare_output()
   std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // tmp, final
   OutputBatch* outer_;
 };

@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include "../errors.h"
+#include "file_identity.h"
 
 namespace ra {
 
@@ -28,6 +29,7 @@ std::string input_file_problem(const std::filesystem::path& path) {
 void check_input_file(const std::filesystem::path& path) {
   const std::string why = input_file_problem(path);
   if (!why.empty()) throw InputError(located(path.string(), 0, why));
+  note_input(path);  // an output naming this file is refused
 }
 
 }  // namespace ra

@@ -12,7 +12,8 @@ namespace ra {
 // levels of symbolic links").
 std::string input_file_problem(const std::filesystem::path& path);
 
-// Throws InputError "PATH: problem" when input_file_problem() is not empty.
+// Throws InputError "PATH: problem" when input_file_problem() is not empty;
+// otherwise notes the file as an input (file_identity.h).
 void check_input_file(const std::filesystem::path& path);
 
 }  // namespace ra

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "registry.h"
+#include "../registry.h"
 
 namespace ra {
 namespace {

@@ -8,7 +8,7 @@
 #include <random>
 #include <string>
 
-#include "registry.h"
+#include "../registry.h"
 
 namespace ra {
 namespace {

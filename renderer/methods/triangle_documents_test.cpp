@@ -10,7 +10,7 @@
 #include "methods/areas.h"
 #include "methods/cramer.h"
 #include "methods/sameside.h"
-#include "registry.h"
+#include "../registry.h"
 
 namespace ra {
 namespace {

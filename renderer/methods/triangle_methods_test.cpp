@@ -10,7 +10,7 @@
 #include <string>
 #include <utility>
 
-#include "registry.h"
+#include "../registry.h"
 
 namespace ra {
 namespace {

@@ -7,6 +7,8 @@
 
 #include <exception>
 #include <memory>
+#include <new>
+#include <stdexcept>
 
 #include "../image_module.h"
 
@@ -67,6 +69,14 @@ bool write_exr(const char* path, int w, int h, const float* rgb, std::string* er
   return false;
 }
 
+// A reader's allocation for an absurd declared size fails inside the
+// library ("vector::_M_default_append" for a 65535x65535 GIF): said as such.
+std::string exception_text(const std::exception& e) {
+  if (dynamic_cast<const std::length_error*>(&e) || dynamic_cast<const std::bad_alloc*>(&e))
+    return "the size the file declares cannot be allocated (corrupt header?)";
+  return e.what();
+}
+
 void* open(const char* path, Header* header, std::string* err) try {
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
@@ -77,7 +87,7 @@ void* open(const char* path, Header* header, std::string* err) try {
   *header = Header{spec.width, spec.height, spec.nchannels};
   return in.release();
 } catch (const std::exception& e) {
-  *err = e.what();
+  *err = exception_text(e);
   return nullptr;
 }
 
@@ -87,9 +97,16 @@ bool read(void* image, int channels, float* dst, std::string* err) try {
     *err = first_line(in->geterror());
     return false;
   }
+  // Some readers return true for a truncated file (a JPEG cut short, a PNG
+  // without IEND) and only record the error: such a texture was used with
+  // its missing part grey (issue 15's third pass).
+  if (in->has_error()) {
+    *err = first_line(in->geterror());
+    return false;
+  }
   return true;
 } catch (const std::exception& e) {
-  *err = e.what();
+  *err = exception_text(e);
   return false;
 }
 

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "../errors.h"
+#include "../io/file_identity.h"
 #include "../io/input_file.h"
 #include "../io/json_input.h"
 #include "scene_mesh.h"
@@ -25,7 +26,10 @@ using json = nlohmann::json;
 // (a directory, a FIFO that would block, a device); empty when it is one.
 std::string file_problem(const std::filesystem::path& p) {
   const std::string why = input_file_problem(p);
-  if (why.empty()) return why;
+  if (why.empty()) {
+    note_input(p);  // a texture or mesh is never replaced by an output
+    return why;
+  }
   return why == "no such file" ? "file not found: " + p.string() : p.string() + ": " + why;
 }
 
@@ -39,7 +43,7 @@ class ObjectReader {
   }
 
   [[noreturn]] void fail(const std::string& where, const std::string& what) const {
-    throw InputError(file_ + ": " + where + ": " + what);
+    throw InputError(located(file_, 0, where + ": " + what));  // control bytes in a key or path escaped
   }
   std::string at(const std::string& key) const { return path_ + "/" + key; }
   bool has(const std::string& key) {
@@ -51,17 +55,24 @@ class ObjectReader {
     return j_.at(key);
   }
 
+  // Scene numbers are bounded: a camera at 1e308 or a radius of 1e308 gave
+  // an all-black image (their squares overflow), a scale of 1e-320 too.
+  static constexpr double kMaxMagnitude = 1e30, kMinPositive = 1e-30;
+  static constexpr const char* kMagnitudeRule = "magnitude above 1e30 (its square would overflow a double's products)";
+
   double number(const std::string& key, double def) {
     if (!has(key)) return def;
     const json& v = j_.at(key);
     if (!v.is_number()) fail(at(key), "expected a number, got " + std::string(v.type_name()));
     const double d = v.get<double>();
     if (!std::isfinite(d)) fail(at(key), "expected a finite number");
+    if (std::fabs(d) > kMaxMagnitude) fail(at(key), kMagnitudeRule);
     return d;
   }
   double positive(const std::string& key, double def) {
     const double d = number(key, def);
     if (!(d > 0)) fail(at(key), "must be greater than 0");
+    if (d < kMinPositive) fail(at(key), "must be at least 1e-30 (smaller sizes vanish in a double's products)");
     return d;
   }
   int integer(const std::string& key, int def, int lo, int hi) {
@@ -92,6 +103,7 @@ class ObjectReader {
       if (!v[i].is_number()) r.fail(where + "/" + std::to_string(i), "expected a number");
       out[i] = v[i].get<double>();
       if (!std::isfinite(out[i])) r.fail(where + "/" + std::to_string(i), "expected a finite number");
+      if (std::fabs(out[i]) > kMaxMagnitude) r.fail(where + "/" + std::to_string(i), kMagnitudeRule);
     }
     return out;
   }
@@ -285,6 +297,7 @@ Scene parse_scene_json(const std::string& text, const std::filesystem::path& fil
   s.ambient_light = r.color("ambient_light", s.ambient_light);
   s.max_depth = r.integer("max_depth", s.max_depth, 1, 256);
   s.adc_bailout = r.number("adc_bailout", s.adc_bailout);
+  if (s.adc_bailout < 0) r.fail(r.at("adc_bailout"), "must be 0 or more");
   if (r.has("lights")) {
     const json& ls = r.get("lights");
     if (!ls.is_array()) r.fail("/lights", "expected an array");
