@@ -259,6 +259,25 @@ struct BoxRay8 {
 // generic code inlined into the tracer's AVX2+FMA entry points (GCC does
 // not inline target-specific intrinsics into it); only those entry points
 // instantiate them (traverse's kFma).
+#if defined(__clang__)
+// clang accepts a 32-byte "x" operand only in functions compiled for AVX,
+// and this generic code is not. Lane by lane, the same values: fmaf rounds
+// a * b - c once, as vfmsub213ps does (clang builds only the fuzz targets).
+[[gnu::always_inline]] inline v8f fmsub(v8f a, v8f b, v8f c) {
+  for (int i = 0; i < 8; ++i) a[i] = std::fmaf(a[i], b[i], -c[i]);
+  return a;
+}
+[[gnu::always_inline]] inline v8f fmadd(v8f a, v8f b, v8f c) {
+  for (int i = 0; i < 8; ++i) a[i] = std::fmaf(a[i], b[i], c[i]);
+  return a;
+}
+[[gnu::always_inline]] inline float lane_avx(v8f v, int i) { return v[i]; }
+[[gnu::always_inline]] inline int movemask_avx(v8i m) {
+  int r = 0;
+  for (int i = 0; i < 8; ++i) r |= (m[i] < 0 ? 1 : 0) << i;
+  return r;
+}
+#else
 [[gnu::always_inline]] inline v8f fmsub(v8f a, v8f b, v8f c) {
   asm("vfmsub213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
   return a;
@@ -281,6 +300,7 @@ struct BoxRay8 {
   asm("vmovmskps %1, %0" : "=r"(r) : "x"(m));
   return r;
 }
+#endif
 
 // meet8 with one fused multiply-subtract per plane, t = p inv - oi, for
 // rays with fma_ok (Embree's form; here made conservative). Against
