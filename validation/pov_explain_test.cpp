@@ -50,6 +50,24 @@ TEST(PovExplain, CornellBoxEdgePixelIsPovsMeshInsideTest) {
   }
 }
 
+// Renders `scene` with us and with POV-Ray: pixel (x, y) must differ (else
+// the case is gone and the test says so), every differing pixel must have a
+// cause, and (x, y)'s must start with `cause`.
+void expect_pixel_differs_and_is_explained_by(const Scene& scene, int x, int y, const std::string& cause) {
+  RenderOptions opt;
+  opt.progress = false;
+  const Image ours = render(scene, opt);
+  const Image pov = render_with_povray(scene).image;
+  const ImageComparison c = compare_images(ours, pov, 8);
+  bool found = false;
+  for (const auto& d : c.differences) found |= d.x == x && d.y == y;
+  ASSERT_TRUE(found) << "POV-Ray and we no longer differ at (" << x << ", " << y << "): the case is gone";
+  for (const auto& e : explain_differences(scene, ours, pov, c, opt)) {
+    EXPECT_FALSE(e.cause.empty()) << "(" << e.x << ", " << e.y << ") unexplained";
+    if (e.x == x && e.y == y) EXPECT_EQ(e.cause.rfind(cause, 0), 0u) << e.cause;
+  }
+}
+
 // Random scene 3-179 shrunk (compare --random 200 --seed 3): a reflective,
 // nearest-textured, smooth regr01.obj scaled to 5e-4, no lights. Its UVs
 // run over hundreds of repeats across a triangle, so two reflections turn a
@@ -75,20 +93,7 @@ TEST(PovExplain, RandomScene3_179PixelIsPovsFloat32Perp) {
   for (const char* input : {"corpus/ladder/drkwood2.jpg", "corpus/assimp-obj/regr01.obj"})
     if (!std::filesystem::exists(cache_dir() / input)) GTEST_SKIP() << "the corpus cache lacks " << input;
   const Scene scene = parse_scene_json(text, file);
-  RenderOptions opt;
-  opt.progress = false;
-  const Image ours = render(scene, opt);
-  const Image pov = render_with_povray(scene).image;
-  const ImageComparison c = compare_images(ours, pov, 8);
-  bool found = false;
-  for (const auto& d : c.differences) found |= d.x == 87 && d.y == 95;
-  ASSERT_TRUE(found) << "POV-Ray and we no longer differ at (87, 95): the case is gone";
-  for (const auto& e : explain_differences(scene, ours, pov, c, opt)) {
-    EXPECT_FALSE(e.cause.empty()) << "(" << e.x << ", " << e.y << ") unexplained";
-    if (e.x == 87 && e.y == 95) {
-      EXPECT_EQ(e.cause.rfind("mesh2 hit point", 0), 0u) << e.cause;
-    }
-  }
+  expect_pixel_differs_and_is_explained_by(scene, 87, 95, "mesh2 hit point");
 }
 
 // The spider at 160 x 120 (issue 18): pixel (87, 53) is 1/255 off, with our
@@ -106,20 +111,7 @@ TEST(PovExplain, SpiderPixelIsPovsMeshUVOnDoubleUVs) {
   Scene scene = load_scene(file);
   scene.width = 160;
   scene.height = 120;
-  RenderOptions opt;
-  opt.progress = false;
-  const Image ours = render(scene, opt);
-  const Image pov = render_with_povray(scene).image;
-  const ImageComparison c = compare_images(ours, pov, 8);
-  bool found = false;
-  for (const auto& d : c.differences) found |= d.x == 87 && d.y == 53;
-  ASSERT_TRUE(found) << "POV-Ray and we no longer differ at (87, 53): the case is gone";
-  for (const auto& e : explain_differences(scene, ours, pov, c, opt)) {
-    EXPECT_FALSE(e.cause.empty()) << "(" << e.x << ", " << e.y << ") unexplained";
-    if (e.x == 87 && e.y == 53) {
-      EXPECT_EQ(e.cause.rfind("mesh2 UV", 0), 0u) << e.cause;
-    }
-  }
+  expect_pixel_differs_and_is_explained_by(scene, 87, 53, "mesh2 UV");
 }
 
 // A smooth triangle whose three normals differ by 1e-6 (|N1 - N2|^2 =
