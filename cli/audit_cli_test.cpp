@@ -391,6 +391,16 @@ TEST(AuditGrade, AnswersEncodingAndNonFilesAreNamed) {
   r = rayaudit(grade);
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, answers.string() + ":1: the file is UTF-16 (or holds NUL bytes): save it as UTF-8 or ASCII\n");
+  // A column named twice: which one counts would be a guess (the answers
+  // reader now shares the cases reader's header check).
+  write(answers, "id,hit,t,t\na,true,1,2\n");
+  const std::string before = slurp(json);  // the BOM run's output, which must stay
+  r = rayaudit(grade);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(answers.string() + ":1: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'t'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+  EXPECT_EQ(slurp(json), before) << "an existing output must be left untouched";
   fs::remove(answers);
   ASSERT_EQ(::mkfifo(answers.c_str(), 0644), 0);
   r = rayaudit(grade);

@@ -82,12 +82,8 @@ std::vector<UserCase> read_cases_csv(const std::string& path) {
   return cases;
 }
 
-void for_each_case(const std::string& path, const std::function<void(const UserCase&, long line)>& visit) {
-  check_input_file(path);  // a directory is not "empty", a FIFO does not block
-  std::ifstream in(path);
-  if (!in) throw InputError(located(path, 0, "cannot open the cases file"));
+std::vector<std::string> read_csv_header(std::istream& in, const std::string& path, long& lineno) {
   std::string line;
-  long lineno = 0;
   std::vector<std::string> header;
   while (header.empty() && std::getline(in, line)) {
     ++lineno;
@@ -96,6 +92,16 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
     if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
   }
   check_unique_columns(path, lineno, header);
+  return header;
+}
+
+void for_each_case(const std::string& path, const std::function<void(const UserCase&, long line)>& visit) {
+  check_input_file(path);  // a directory is not "empty", a FIFO does not block
+  std::ifstream in(path);
+  if (!in) throw InputError(located(path, 0, "cannot open the cases file"));
+  std::string line;
+  long lineno = 0;
+  const std::vector<std::string> header = read_csv_header(in, path, lineno);
   if (header.empty()) throw InputError(located(path, lineno, "empty file: expected a header line"));
   int col[15];
   int id_col = -1;

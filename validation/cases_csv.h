@@ -9,6 +9,7 @@
 // %a, then verdict and t (%a, empty when there is no crossing).
 #pragma once
 #include <functional>
+#include <istream>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,10 @@ std::vector<std::string> split_fields(const std::string& line, char sep = ',');
 // (a BOM or NUL bytes) is refused by name (InputError FILE:LINE), not
 // reported as a missing column. Shared by the cases and answers readers.
 void check_header_encoding(const std::string& path, long lineno, std::string& line);
+// The first non-blank line of `in` as header fields (encoding checked,
+// a column named twice refused); lineno counts the lines read. Empty if the
+// file holds no header: the caller says what it expected.
+std::vector<std::string> read_csv_header(std::istream& in, const std::string& path, long& lineno);
 // True if the whole field is one number (decimal or hex float) that does not
 // overflow; underflow to a subnormal is accepted.
 bool parse_double(const std::string& s, double& out);

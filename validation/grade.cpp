@@ -36,13 +36,8 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
   if (!in) throw InputError(located(path, 0, "cannot open the answers file"));
   std::string line;
   long lineno = 0;
-  std::vector<std::string> header;
-  while (header.empty() && std::getline(in, line)) {
-    ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    check_header_encoding(path, lineno, line);  // a BOM dropped, UTF-16 named (was "missing column 'id'")
-    if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
-  }
+  // The cases reader's: a BOM dropped, UTF-16 named, a column named twice refused.
+  const std::vector<std::string> header = read_csv_header(in, path, lineno);
   if (header.empty()) throw InputError(located(path, lineno, "empty file: expected a header line id,hit,t"));
   auto column = [&](const char* name) {
     for (std::size_t i = 0; i < header.size(); ++i)
