@@ -739,41 +739,6 @@ TEST(Doc004Cube, EveryMethodDiffersFromMollerOnlyAlongTriangleEdges) {
   EXPECT_GT(differing_total, 0);
 }
 
-TEST(Accel, BvhLeavesHoldAtMostFourTrianglesAndEveryTriangleOnce) {
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(-10, 10);
-  std::vector<Vec3d> lo, hi;
-  for (int i = 0; i < 5000; ++i) {
-    const Vec3d c{u(rng), u(rng), u(rng)};
-    lo.push_back(c - Vec3d{0.1, 0.1, 0.1});
-    hi.push_back(c + Vec3d{0.1, 0.2, 0.05});
-  }
-  const Bvh b = Bvh::build(lo, hi, 0);
-  std::vector<int> seen(lo.size(), 0);
-  int leaves = 0;
-  for (const auto& n : b.nodes)
-    for (int i = 0; i < Bvh::kWidth; ++i) {
-      if (!Bvh::is_leaf(n.child[i])) continue;
-      ++leaves;
-      const unsigned first = Bvh::leaf_first(n.child[i]), count = Bvh::leaf_count(n.child[i]);
-      EXPECT_EQ(first % 4, 0u);
-      EXPECT_LE(count, unsigned(Bvh::kMaxLeaf));
-      for (unsigned s = first; s < first + 4; ++s) {
-        if (s >= first + count) {
-          EXPECT_EQ(b.order[s], Bvh::kNoTriangle);
-          continue;
-        }
-        ++seen[b.order[s]];
-        for (int a = 0; a < 3; ++a) {
-          EXPECT_LE(n.lo[a][i], lo[b.order[s]][a]);
-          EXPECT_GE(n.hi[a][i], hi[b.order[s]][a]);
-        }
-      }
-    }
-  EXPECT_EQ(std::size_t(leaves) * 4, b.order.size());
-  for (int c : seen) EXPECT_EQ(c, 1);
-}
-
 // ------------------------------------------------------ MTL and placement
 
 TEST(MtlMapping, PhongTermsMapOntoPovFinish) {

@@ -209,7 +209,7 @@ bool same_tree(const Bvh& a, const Bvh& b) {
 // stack allows. Returns the number of nodes reached.
 std::size_t check_structure(const Bvh& b, const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi) {
   std::vector<int> seen(lo.size(), 0), reached(b.nodes.size(), 0);
-  std::size_t nodes = 0;
+  std::size_t nodes = 0, leaves = 0;
   struct Item {
     std::uint32_t node;
     int depth;
@@ -233,6 +233,8 @@ std::size_t check_structure(const Bvh& b, const std::vector<Vec3d>& lo, const st
       ++used;
       if (Bvh::is_leaf(c)) {
         const unsigned first = Bvh::leaf_first(c), count = Bvh::leaf_count(c);
+        ++leaves;
+        EXPECT_EQ(first % 4, 0u);  // a leaf is one aligned block of 4 slots
         EXPECT_LE(count, unsigned(Bvh::kMaxLeaf));
         for (unsigned s = first; s < first + 4; ++s) {
           if (s >= first + count) {
@@ -261,7 +263,21 @@ std::size_t check_structure(const Bvh& b, const std::vector<Vec3d>& lo, const st
   }
   for (std::size_t t = 0; t < seen.size(); ++t) EXPECT_EQ(seen[t], 1) << "triangle " << t;
   EXPECT_EQ(nodes, b.nodes.size());
+  EXPECT_EQ(leaves * 4, b.order.size());  // no slot outside a leaf
   return nodes;
+}
+
+// Small boxes spread over a cube, built with the default thread count.
+TEST(Bvh, LeavesHoldAtMostFourTrianglesAndEveryTriangleOnce) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-10, 10);
+  std::vector<Vec3d> lo, hi;
+  for (int i = 0; i < 5000; ++i) {
+    const Vec3d c{u(rng), u(rng), u(rng)};
+    lo.push_back(c - Vec3d{0.1, 0.1, 0.1});
+    hi.push_back(c + Vec3d{0.1, 0.2, 0.05});
+  }
+  check_structure(Bvh::build(lo, hi, 0), lo, hi);
 }
 
 // Large enough for the splits spread over threads and the subtree tasks.
