@@ -1,12 +1,15 @@
 // `rayaudit golden check|bless [SCENE...]`: golden images of scenes/*.json
 // (validation/golden.h). check renders and compares (exit 1 on any
 // difference, writing a diff image); bless rewrites goldens, only when asked.
+#include <algorithm>
 #include <iostream>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "io/file_identity.h"
 #include "golden.h"
 
 namespace {
@@ -16,6 +19,7 @@ struct Args {
   std::string root = RAYAUDIT_SOURCE_DIR;
   std::string diff_dir, json;
   bool skip_unavailable = false;
+  bool diff_dir_given = false, json_given = false;
 };
 
 // A scene's name is its path under scenes/ without ".json":
@@ -31,9 +35,28 @@ std::vector<std::string> names_of(const std::vector<std::string>& given, const r
     std::string rel = p.generic_string();
     if (rel.rfind("scenes/", 0) == 0) rel = rel.substr(7);
     const bool plain = !p.is_absolute() && rel.find("..") == std::string::npos;
-    out.push_back(plain ? rel : p.filename().string());
+    std::string name = plain ? rel : p.filename().string();
+    // A scene named twice is checked once (its diff images would be two
+    // outputs on one path).
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(std::move(name));
   }
   return out;
+}
+
+// An output directory that may not exist yet (check creates it): the
+// nearest existing ancestor must be a directory.
+void check_creatable_dir(const std::filesystem::path& dir, const std::string& flag) {
+  std::error_code ec;
+  for (std::filesystem::path p = std::filesystem::absolute(dir, ec); !p.empty(); p = p.parent_path()) {
+    const auto st = std::filesystem::status(p, ec);
+    if (st.type() == std::filesystem::file_type::not_found) {
+      if (p == p.parent_path()) break;
+      continue;
+    }
+    if (st.type() != std::filesystem::file_type::directory)
+      throw ra::InputError(ra::located(p.string(), 0, "is not a directory (" + flag + " " + dir.string() + ")"));
+    return;
+  }
 }
 
 // --root must be a checkout: scenes/ beside golden/ (bless may create golden/).
@@ -43,17 +66,42 @@ void check_root(const Args& a) {
 }
 
 void check(const Args& a) {
+  if (a.diff_dir_given && a.diff_dir.empty()) throw ra::InputError("--diff-dir: empty path");
+  if (a.json_given && a.json.empty()) throw ra::InputError("--json: empty path");
   check_root(a);
-  ra::OutputBatch outputs({a.json});
-  const ra::GoldenSet set(a.root);
+  const ra::GoldenSet set(a.root);  // the manifest, noted as an input
   const std::filesystem::path diff_dir =
       a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden" : std::filesystem::path(a.diff_dir);
-  int failed = 0, skipped = 0;
-  nlohmann::json rows = nlohmann::json::array();  // for --json (the report's golden section)
   const auto names = names_of(a.scenes, set);
   if (names.empty())
     throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
                          ": no golden images to check");
+  // Every file the check reads that is known now (scenes, golden images),
+  // then every output, before any work: --diff-dir ROOT/golden would
+  // replace the golden it compares with (issue 15's second pass), --json
+  // naming a diff image would lose it. The scenes' meshes and textures are
+  // noted as they load, and refused there if an output names them; all
+  // outputs are renamed into place together at the end (none on exit 2).
+  for (const auto& n : names)
+    for (const auto& in : set.check_inputs(n)) ra::note_input(in);
+  ra::OutputBatch outputs({a.json});
+  check_creatable_dir(diff_dir, "--diff-dir");
+  std::set<std::filesystem::path> later;  // in directories check() creates: declared when written
+  for (const auto& n : names)
+    for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {
+      if (std::filesystem::is_directory(out.parent_path())) {
+        outputs.add(out);
+      } else {
+        const auto key = std::filesystem::absolute(out).lexically_normal();
+        if (!later.insert(key).second)
+          throw ra::InputError(ra::located(out.string(), 0, "is named as two outputs of this command: one would be lost"));
+      }
+    }
+  auto before_write = [&](const std::filesystem::path& out) {
+    if (later.erase(std::filesystem::absolute(out).lexically_normal())) outputs.add(out);
+  };
+  int failed = 0, skipped = 0;
+  nlohmann::json rows = nlohmann::json::array();  // for --json (the report's golden section)
   for (const auto& n : names) {
     const auto missing = ra::missing_cache_inputs(std::filesystem::path(a.root) / "scenes" / (n + ".json"));
     if (a.skip_unavailable && !missing.empty()) {
@@ -64,16 +112,14 @@ void check(const Args& a) {
       ++skipped;
       continue;
     }
-    const auto r = set.check(n, diff_dir);
+    const auto r = set.check(n, diff_dir, before_write);
     std::cout << (r.pass ? "ok   " : "FAIL ") << r.message << "\n";
     rows.push_back({{"name", n}, {"status", r.pass ? "ok" : "fail"}, {"message", r.message}});
     failed += !r.pass;
   }
   // Written whatever the verdict: a failed check is what the report must show.
-  if (!a.json.empty()) {
-    ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1) + "\n");
-    outputs.commit();
-  }
+  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1) + "\n");
+  outputs.commit();
   if (failed)
     throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
                           " golden image(s) failed");
@@ -83,8 +129,13 @@ void check(const Args& a) {
 void bless(const Args& a) {
   check_root(a);
   ra::GoldenSet set(a.root);
-  for (const auto& n : names_of(a.scenes, set)) std::cout << set.bless(n) << "\n";
+  // Every scene rendered before anything is written (a bad scene after a
+  // good one left the good one's image rewritten and the manifest stale);
+  // what changed is printed once all are written.
+  std::vector<std::string> lines;
+  for (const auto& n : names_of(a.scenes, set)) lines.push_back(set.bless(n));
   set.save();
+  for (const auto& l : lines) std::cout << l << "\n";
 }
 
 void setup(CLI::App& app) {
@@ -96,10 +147,12 @@ void setup(CLI::App& app) {
     sub->add_option("scenes", args->scenes, "Scene names or files (default: every scene in scenes/)");
     sub->add_option("--root", args->root, "The repository (holding scenes/ and golden/)");
     if (std::string(name) == "check") {
-      sub->add_option("--diff-dir", args->diff_dir, "Where to write diff images on failure (default /tmp/rayaudit-golden)");
+      sub->add_option("--diff-dir", args->diff_dir, "Where to write diff images on failure (default /tmp/rayaudit-golden)")
+          ->each([args](const std::string&) { args->diff_dir_given = true; });
       sub->add_flag("--skip-unavailable", args->skip_unavailable,
                     "Skip scenes whose ${cache} inputs are missing; exit 77 when all were skipped");
-      sub->add_option("--json", args->json, "Write each scene's status (ok, fail, skip) and message as JSON");
+      sub->add_option("--json", args->json, "Write each scene's status (ok, fail, skip) and message as JSON")
+          ->each([args](const std::string&) { args->json_given = true; });
     }
     sub->callback([args, fn] { fn(*args); });
   };

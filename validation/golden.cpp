@@ -11,6 +11,7 @@
 #include "errors.h"
 #include "io/input_file.h"
 #include "io/json_input.h"
+#include "registry.h"
 #include "render.h"
 #include "scene/scene_mesh.h"
 
@@ -98,17 +99,84 @@ json to_json(const GoldenEntry& e) {
           {"inputs_hash", e.inputs_hash},                 {"inputs", e.inputs}};
 }
 
-GoldenEntry entry_from(const json& j) {
+// A JSON value as the file has it, for a message: numbers and booleans as
+// written (9223372036854775808, not the -9223372036854775808 a cast gives),
+// anything else by its type.
+std::string shown(const json& v) {
+  if (v.is_number() || v.is_boolean()) return v.dump();
+  return v.type_name();
+}
+
+// One manifest entry, read strictly as scene files are (issue 15's second
+// pass: "spp": 0 put at the wrong level, a misspelt "widht" and "width":
+// 1.5 read as 1 all passed): an unknown key, a value of the wrong type or
+// out of range is an error at its JSON path, quoting the file's value.
+// `fail(path, what)` throws.
+template <class Fail>
+GoldenEntry entry_from(const json& j, const std::string& at, const Fail& fail) {
+  static const std::set<std::string> known = {"name",   "scene", "image",       "width",  "height",
+                                              "bits",   "settings", "inputs_hash", "inputs"};
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!known.count(it.key())) fail(at + "/" + it.key(), "unknown key");
+  auto need = [&](const char* key) -> const json& {
+    if (!j.contains(key)) fail(at, std::string("needs \"") + key + "\"");
+    return j.at(key);
+  };
+  auto string = [&](const json& v, const std::string& where) {
+    if (!v.is_string()) fail(where, "expected a string, got " + shown(v));
+    return v.get<std::string>();
+  };
+  auto integer = [&](const json& v, const std::string& where, long long lo, long long hi, const char* unit) {
+    if (!v.is_number_integer()) fail(where, "expected an integer, got " + shown(v));
+    const bool in = v.is_number_unsigned() ? v.get<unsigned long long>() <= static_cast<unsigned long long>(hi) &&
+                                                 static_cast<long long>(v.get<unsigned long long>()) >= lo
+                                           : v.get<long long>() >= lo && v.get<long long>() <= hi;
+    if (!in) fail(where, v.dump() + " is not " + std::to_string(lo) + " to " + std::to_string(hi) + unit);
+    return int(v.get<long long>());
+  };
   GoldenEntry e;
-  e.name = j.at("name").get<std::string>();
-  e.scene = j.at("scene").get<std::string>();
-  e.image = j.at("image").get<std::string>();
-  e.width = j.at("width").get<int>();
-  e.height = j.at("height").get<int>();
-  e.bits = j.value("bits", 8);
-  e.settings = j.value("settings", default_settings());
-  e.inputs_hash = j.at("inputs_hash").get<std::string>();
-  e.inputs = j.value("inputs", std::map<std::string, std::string>{});
+  e.name = string(need("name"), at + "/name");
+  e.scene = string(need("scene"), at + "/scene");
+  e.image = string(need("image"), at + "/image");
+  e.width = integer(need("width"), at + "/width", 1, kMaxImageSide, " pixels");
+  e.height = integer(need("height"), at + "/height", 1, kMaxImageSide, " pixels");
+  if (j.contains("bits")) {
+    const json& b = j.at("bits");
+    if (b != 8 && b != 16) fail(at + "/bits", "must be 8 or 16, got " + shown(b));
+    e.bits = b.get<int>();
+  }
+  e.settings = default_settings();
+  if (j.contains("settings")) {
+    const json& s = j.at("settings");
+    const std::string sat = at + "/settings";
+    if (!s.is_object()) fail(sat, "expected an object, got " + shown(s));
+    for (auto it = s.begin(); it != s.end(); ++it) {
+      const std::string where = sat + "/" + it.key();
+      if (!e.settings.contains(it.key())) fail(where, "unknown key");
+      const json& v = it.value();
+      if (it.key() == "spp") {
+        const int spp = integer(v, where, 1, 256, "");
+        const int n = int(std::lround(std::sqrt(double(spp))));
+        if (n * n != spp) fail(where, "must be a square number of samples (1, 4, 9, ...), got " + v.dump());
+      } else {
+        const std::string name = string(v, where);
+        bool ok = true;
+        if (it.key() == "triangle_method") ok = find_method(name) && find_method(name)->kind == Kind::triangle;
+        else if (it.key() == "sphere_method") ok = find_method(name) && find_method(name)->kind == Kind::sphere;
+        else if (it.key() == "precision") ok = name == "float" || name == "double";
+        else if (it.key() == "self_intersection") ok = parse_self_intersection(name).has_value();
+        else if (it.key() == "accel") ok = parse_accel(name).has_value();
+        if (!ok) fail(where, "\"" + name + "\" is not a valid value");
+      }
+      e.settings[it.key()] = v;
+    }
+  }
+  e.inputs_hash = string(need("inputs_hash"), at + "/inputs_hash");
+  if (j.contains("inputs")) {
+    const json& in = j.at("inputs");
+    if (!in.is_object()) fail(at + "/inputs", "expected an object, got " + shown(in));
+    for (auto it = in.begin(); it != in.end(); ++it) e.inputs[it.key()] = string(it.value(), at + "/inputs/" + it.key());
+  }
   return e;
 }
 
@@ -129,10 +197,6 @@ std::string entry_problem(const GoldenEntry& e) {
   if (!inside_root(e.name)) return "name \"" + e.name + "\" must be a relative path without \"..\"";
   if (!inside_root(e.scene)) return "scene \"" + e.scene + "\" must be a relative path under the root without \"..\"";
   if (!inside_root(e.image)) return "image \"" + e.image + "\" must be a relative path under the root without \"..\"";
-  if (e.width < 1 || e.height < 1 || e.width > int(kMaxImageSide) || e.height > int(kMaxImageSide))
-    return "size " + std::to_string(e.width) + "x" + std::to_string(e.height) + " is not 1 to " +
-           std::to_string(kMaxImageSide) + " pixels a side";
-  if (e.bits != 8 && e.bits != 16) return "bits must be 8 or 16, got " + std::to_string(e.bits);
   return "";
 }
 
@@ -215,12 +279,10 @@ GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
     for (std::size_t i = 0; i < all.size(); ++i) {
       const std::string at = m.string() + ": /goldens/" + std::to_string(i);
       if (!all[i].is_object()) throw InputError(at + ": expected an object");
-      GoldenEntry g;
-      try {
-        g = entry_from(all[i]);
-      } catch (const json::exception& e) {
-        throw InputError(at + ": " + json_error_text(e));
-      }
+      const GoldenEntry g = entry_from(all[i], "/goldens/" + std::to_string(i),
+                                       [&](const std::string& where, const std::string& what) {
+                                         throw InputError(located(m.string(), 0, where + ": " + what));
+                                       });
       if (const std::string why = entry_problem(g); !why.empty()) throw InputError(at + ": " + why);
       if (entries_.count(g.name)) throw InputError(at + ": golden \"" + g.name + "\" listed twice");
       entries_[g.name] = g;
@@ -252,7 +314,18 @@ Image render_golden(const fs::path& scene_file, int w, int h, const json& settin
 
 }  // namespace
 
-GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff_dir) const {
+std::vector<fs::path> GoldenSet::check_inputs(const std::string& name) const {
+  std::vector<fs::path> out{root_ / "scenes" / (name + ".json")};
+  if (auto it = entries_.find(name); it != entries_.end()) out.push_back(root_ / it->second.image);
+  return out;
+}
+
+std::vector<fs::path> GoldenSet::diff_outputs(const std::string& name, const fs::path& diff_dir) {
+  return {diff_dir / (name + ".diff.png"), diff_dir / (name + ".png")};
+}
+
+GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff_dir,
+                                   const std::function<void(const fs::path&)>& before_write) const {
   const fs::path scene_file = root_ / "scenes" / (name + ".json");
   auto it = entries_.find(name);
   if (it == entries_.end())
@@ -285,9 +358,12 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
     return {false, msg};
   }
   std::error_code ec;
-  const fs::path diff = diff_dir / (name + ".diff.png"), mine = diff_dir / (name + ".png");
+  const auto paths = diff_outputs(name, diff_dir);
+  const fs::path &diff = paths[0], &mine = paths[1];
   fs::create_directories(diff.parent_path(), ec);  // names may hold a folder: corpus/ladder-10-box
+  if (before_write) before_write(diff);
   write_image(diff, difference_image(ours, golden, g.bits));
+  if (before_write) before_write(mine);
   write_image(mine, ours);
   msg = name + ": differs from " + g.image + " (" + size + ")\n" + summary(c);
   msg += "diff image: " + diff.string() + "\nthis render: " + mine.string() + "\n";
@@ -304,10 +380,9 @@ std::string GoldenSet::bless(const std::string& name) {
   if (!fs::exists(scene_file)) {
     auto it = entries_.find(name);
     if (it == entries_.end()) throw InputError(scene_file.string() + ": no such scene");
-    std::error_code ec;
-    fs::remove(root_ / it->second.image, ec);
+    pending_removal_.push_back(root_ / it->second.image);
+    pending_.erase(root_ / it->second.image);
     entries_.erase(it);
-    removed_ = true;
     return name + ": removed (its scene is gone)";
   }
   GoldenEntry g;
@@ -349,14 +424,12 @@ std::string GoldenSet::bless(const std::string& name) {
     else
       what += "; inputs unchanged";
   }
-  std::error_code ec;
-  fs::create_directories((root_ / g.image).parent_path(), ec);
-  if (write_png) write_image(root_ / g.image, img, {8, false});
+  if (write_png) pending_[root_ / g.image] = img;
   entries_[name] = g;
   return what;
 }
 
-void GoldenSet::save() const {
+void GoldenSet::save() {
   json all = json::array();
   for (const auto& [n, e] : entries_) all.push_back(to_json(e));
   json j = {{"about", "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
@@ -364,7 +437,22 @@ void GoldenSet::save() const {
             {"goldens", all}};
   std::error_code ec;
   fs::create_directories(root_ / "golden", ec);
-  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2) + "\n");
+  for (const auto& [path, img] : pending_) fs::create_directories(path.parent_path(), ec);
+  {
+    // Each image replaces the golden it was compared with (an input of
+    // this run, so not declared as an output: io/file_identity.h would
+    // refuse it); all renamed together after the last is written.
+    OutputBatch batch({});
+    const fs::path manifest = root_ / "golden" / "manifest.json";
+    batch.add_replacement(manifest);
+    for (const auto& [path, img] : pending_) batch.add_replacement(path);
+    for (const auto& [path, img] : pending_) write_image(path, img, {8, false});
+    write_text_atomically(manifest, j.dump(2) + "\n");
+    batch.commit();
+  }
+  pending_.clear();
+  for (const auto& p : pending_removal_) fs::remove(p, ec);
+  pending_removal_.clear();
 }
 
 }  // namespace ra

@@ -7,11 +7,13 @@
 // asked; CI never blesses.
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "image.h"
 #include "image_compare.h"
 #include "scene/scene.h"
 
@@ -54,19 +56,35 @@ class GoldenSet {
     bool pass = false;
     std::string message;  // what was found, with the diff image's path on failure
   };
-  // Renders `name` and compares with its golden; on failure writes
-  // diff_dir/NAME.diff.png (false colour) and diff_dir/NAME.png (ours).
-  Result check(const std::string& name, const std::filesystem::path& diff_dir) const;
+  // The files check(name) reads that exist now: the scene file and the
+  // golden image (the scene's meshes and textures are known once it is
+  // loaded). A command notes them as inputs (io/file_identity.h) before
+  // declaring its outputs, so --diff-dir ROOT/golden is refused before any work.
+  std::vector<std::filesystem::path> check_inputs(const std::string& name) const;
 
-  // Renders `name` and records it; returns a line saying what changed.
-  // save() writes the manifest.
+  // The images check() writes for `name` on failure, in this order.
+  static std::vector<std::filesystem::path> diff_outputs(const std::string& name,
+                                                         const std::filesystem::path& diff_dir);
+
+  // Renders `name` and compares with its golden; on failure writes
+  // diff_dir/NAME.diff.png (false colour) and diff_dir/NAME.png (ours),
+  // calling before_write(path) first (after creating its directory).
+  Result check(const std::string& name, const std::filesystem::path& diff_dir,
+               const std::function<void(const std::filesystem::path&)>& before_write = {}) const;
+
+  // Renders `name` and records it in memory; returns a line saying what
+  // changed. Nothing is written before save(), which writes every blessed
+  // image and the manifest together (all or none: a scene that fails to
+  // load after others were blessed leaves golden/ as it was), then removes
+  // the goldens of scenes that are gone.
   std::string bless(const std::string& name);
-  void save() const;
+  void save();
 
  private:
   std::filesystem::path root_;
   std::map<std::string, GoldenEntry> entries_;
-  bool removed_ = false;
+  std::map<std::filesystem::path, Image> pending_;      // blessed images, written by save()
+  std::vector<std::filesystem::path> pending_removal_;  // goldens of removed scenes
 };
 
 }  // namespace ra

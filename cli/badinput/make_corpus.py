@@ -169,6 +169,12 @@ put('golden', 'width_string.json', '{"goldens": [{"name": "a", "scene": "scenes/
 put('golden', 'listed_twice.json', '{"goldens": [' + ','.join(
     ['{"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": 8, "height": 8, "inputs_hash": "x"}'] * 2)
     + ']}\n')
+# An entry read strictly (HOSTILE2 F5): unknown keys, sizes that are not integers.
+GOLDEN_A = '"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "height": 8, "inputs_hash": "x"'
+put('golden', 'unknown_key.json', '{"goldens": [{' + GOLDEN_A + ', "width": 8,\n "widht": 8}]}\n')
+put('golden', 'width_fraction.json', '{"goldens": [{' + GOLDEN_A + ', "width": 1.5}]}\n')
+put('golden', 'width_2p63.json', '{"goldens": [{' + GOLDEN_A + ', "width": 9223372036854775808}]}\n')
+put('golden', 'settings_spp_3.json', '{"goldens": [{' + GOLDEN_A + ', "width": 8, "settings": {"spp": 3}}]}\n')
 
 # ---- textures (referenced by a scene the test writes) ----
 def png(w, h, data, color=2, depth=8, crc_ok=True):

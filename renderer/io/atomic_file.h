@@ -50,6 +50,10 @@ class OutputBatch {
   OutputBatch& operator=(const OutputBatch&) = delete;
   // Adds an output known only later (e.g. a texture copied beside a .pov).
   void add(const std::filesystem::path& output);
+  // An output that deliberately replaces one of this run's inputs (`golden
+  // bless` rewrites the golden it compared with): check_output_path() only,
+  // no identity check; staged and renamed with the others.
+  void add_replacement(const std::filesystem::path& output);
   void commit();
 
   // Used by write_atomically: true if `path` is this batch's (the rename waits).

@@ -1,0 +1,155 @@
+// `rayaudit golden` as a user runs it, on a small repository of its own:
+// issue 15's second pass (HOSTILE2 F3-F7): a --diff-dir or --json that is
+// an input or another output, a bless that fails half way, a manifest typo.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "run_rayaudit.h"
+
+namespace fs = std::filesystem;
+using ra::test::run_rayaudit;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == s.size() - 1; }
+
+// A repository with two scenes, a and b, blessed; then a's golden image
+// replaced by b's (same size, different pixels), so `check a` fails.
+class GoldenDataCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root = fs::temp_directory_path() / ("rayaudit-golden-cli-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(root);
+    fs::create_directories(root / "scenes");
+    for (const char* n : {"a", "b"})
+      std::ofstream(root / "scenes" / (std::string(n) + ".json"))
+          << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}, "material": {"color": )"
+          << (n[0] == 'a' ? "0.5" : "0.25") << "}}]}\n";
+    ASSERT_EQ(run_rayaudit("golden bless --root " + root.string()).code, 0);
+    fs::copy_file(root / "golden" / "b.png", root / "golden" / "a.png", fs::copy_options::overwrite_existing);
+    golden_a = slurp(root / "golden" / "a.png");
+    manifest = slurp(root / "golden" / "manifest.json");
+  }
+  void TearDown() override { fs::remove_all(root); }
+  fs::path root;
+  std::string golden_a, manifest;
+};
+
+// F3: the render written as DIFFDIR/a.png replaced golden/a.png, so the
+// next check passed. Refused before the work; the golden untouched.
+TEST_F(GoldenDataCli, DiffDirThatHoldsTheGoldensIsRefusedBeforeTheWork) {
+  const auto r = run_rayaudit("golden check a --root " + root.string() + " --diff-dir " + (root / "golden").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find((root / "golden" / "a.png").string() + ": is also an input of this command"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out, "") << "refused before rendering";
+  EXPECT_EQ(slurp(root / "golden" / "a.png"), golden_a);
+  EXPECT_FALSE(fs::exists(root / "golden" / "a.diff.png"));
+}
+
+// F6: --json naming one of the diff images lost the render.
+TEST_F(GoldenDataCli, JsonNamingADiffImageIsRefusedAsTwoOutputs) {
+  fs::create_directories(root / "out");
+  const auto r = run_rayaudit("golden check a --root " + root.string() + " --diff-dir " + (root / "out").string() +
+                              " --json " + (root / "out" / "a.png").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("is named as two outputs of this command"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(root / "out"));
+}
+
+// F7: an empty --diff-dir (or --json) meant the default.
+TEST_F(GoldenDataCli, EmptyDiffDirOrJsonIsRefused) {
+  auto r = run_rayaudit("golden check a --root " + root.string() + " --diff-dir ''");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, "--diff-dir: empty path\n");
+  r = run_rayaudit("golden check a --root " + root.string() + " --json ''");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, "--json: empty path\n");
+}
+
+// A failing check still writes its diff images and JSON (exit 1), into a
+// --diff-dir it creates, with a folder for a scene name that holds one.
+TEST_F(GoldenDataCli, FailingCheckWritesItsDiffImagesIntoANewDirectory) {
+  const fs::path out = root / "new" / "diffs";
+  const auto r = run_rayaudit("golden check a b --root " + root.string() + " --diff-dir " + out.string() +
+                              " --json " + (root / "g.json").string());
+  EXPECT_EQ(r.code, 1) << r.all;
+  EXPECT_TRUE(fs::exists(out / "a.diff.png"));
+  EXPECT_TRUE(fs::exists(out / "a.png"));
+  EXPECT_FALSE(fs::exists(out / "b.png")) << "b passed";
+  EXPECT_NE(slurp(root / "g.json").find("\"fail\""), std::string::npos);
+}
+
+// A scene that fails to load after a failing one: exit 2 and none of the
+// first one's diff images (outputs are renamed together at the end).
+TEST_F(GoldenDataCli, CheckEndingInABadSceneWritesNothing) {
+  std::ofstream(root / "scenes" / "b.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})" << "\n";
+  fs::create_directories(root / "out");
+  const auto r = run_rayaudit("golden check a b --root " + root.string() + " --diff-dir " + (root / "out").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(fs::is_empty(root / "out"));
+}
+
+// F4: `bless a BAD` rewrote a's golden, then failed on BAD: image and
+// manifest disagreed. Now every scene is rendered before anything is written.
+TEST_F(GoldenDataCli, BlessOfAGoodAndABadSceneWritesNothing) {
+  std::ofstream(root / "scenes" / "z.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})" << "\n";
+  const auto r = run_rayaudit("golden bless a z --root " + root.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.out, "") << "nothing said blessed";
+  EXPECT_EQ(slurp(root / "golden" / "a.png"), golden_a);
+  EXPECT_EQ(slurp(root / "golden" / "manifest.json"), manifest);
+  // And a good bless still rewrites it.
+  const auto ok = run_rayaudit("golden bless a --root " + root.string());
+  EXPECT_EQ(ok.code, 0) << ok.all;
+  EXPECT_NE(ok.out.find("a: image changed"), std::string::npos) << ok.out;
+  EXPECT_NE(slurp(root / "golden" / "a.png"), golden_a);
+}
+
+// F5: unknown keys and non-integer sizes in a manifest entry were ignored
+// or coerced (1.5 -> 1, 2^63 -> 0); each is an error at its JSON path,
+// quoting the file's value.
+TEST_F(GoldenDataCli, ManifestEntriesAreReadStrictly) {
+  struct Case {
+    std::string from, to, says;
+  };
+  const Case cases[] = {
+      {"\"bits\": 8", "\"bits\": 8, \"zzz\": 1", "/goldens/0/zzz: unknown key"},
+      {"\"bits\": 8", "\"bits\": 8, \"spp\": 0", "/goldens/0/spp: unknown key"},
+      {"\"width\": 8", "\"width\": 1.5", "/goldens/0/width: expected an integer, got 1.5"},
+      {"\"width\": 8", "\"width\": true", "/goldens/0/width: expected an integer, got true"},
+      {"\"width\": 8", "\"width\": 9223372036854775808",
+       "/goldens/0/width: 9223372036854775808 is not 1 to 16384 pixels"},
+      {"\"spp\": 1", "\"spp\": 3", "/goldens/0/settings/spp: must be a square number"},
+      {"\"accel\": \"bvh\"", "\"accel\": \"fast\"", "/goldens/0/settings/accel: \"fast\" is not a valid value"},
+  };
+  for (const Case& c : cases) {
+    std::string m = manifest;
+    const auto at = m.find(c.from);
+    ASSERT_NE(at, std::string::npos) << c.from << " in\n" << manifest;
+    m.replace(at, c.from.size(), c.to);
+    std::ofstream(root / "golden" / "manifest.json") << m;
+    const auto r = run_rayaudit("golden check a --root " + root.string());
+    EXPECT_EQ(r.code, 2) << c.to << ": " << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_EQ(r.err.rfind((root / "golden" / "manifest.json").string() + ": " + c.says, 0), 0u) << r.err;
+  }
+}
+
+}  // namespace
