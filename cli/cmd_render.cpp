@@ -1,4 +1,5 @@
 // `rayaudit render SCENE -o OUT`: renders a scene file (or a bare .obj).
+#include <cmath>
 #include <cstdint>
 #include <iostream>
 
@@ -41,6 +42,28 @@ void check_work(const ra::Scene& scene, int spp) {
                          std::to_string(spp) + " spp is " + std::to_string(rays) +
                          " primary rays, more than the limit of " + std::to_string(kMaxPrimaryRays) +
                          " (16384x16384 at 16 spp): lower --width, --height or --spp");
+}
+
+// A radiance that is not a finite float is a property of the scene
+// (reflection above 1 compounding over max_depth levels: 2^256 overflows a
+// float; times a zero channel it is NaN). POV-Ray keeps colours in float and
+// clamps them into 8- and 16-bit files, so a PNG shows +inf as white, as
+// POV's does; an EXR would hold +inf (which our own readers refuse) and
+// NaN means nothing in either: refused, naming the scene and the pixel.
+void check_finite(const ra::Scene& scene, const ra::Image& img, bool exr) {
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float v = img.at(x, y)[c];
+        if (std::isfinite(v) || (!exr && !std::isnan(v))) continue;
+        const std::string what = std::isnan(v) ? "nan" : v > 0 ? "+inf" : "-inf";
+        throw ra::InputError(ra::located(
+            scene.file.string(), 0,
+            "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") has radiance " + what +
+                (std::isnan(v) ? " (an overflowing reflection times a zero channel)" : ", beyond a float's range") +
+                ": reflection above 1 compounds over max_depth " + std::to_string(scene.max_depth) +
+                " levels; lower them" + (exr ? " (a PNG output clamps +inf to white, as POV-Ray does)" : "")));
+      }
 }
 
 void run(const Args& a) {
@@ -97,6 +120,8 @@ void run(const Args& a) {
   // 16 bits), refused now rather than as a bad_alloc after the render.
   ra::check_image_memory("render", scene.width, scene.height, 24);
   const ra::Image img = ra::render(scene, opt);
+  std::string ext = std::filesystem::path(a.out).extension().string();
+  check_finite(scene, img, ext == ".exr" || ext == ".EXR");
   ra::write_image(a.out, img, {a.bits, a.srgb});
 }
 

@@ -18,6 +18,7 @@
 namespace ra {
 
 unsigned quantize(float x, unsigned max) {
+  if (std::isnan(x)) return 0;  // clamp would pass NaN on, and its cast is undefined
   const float c = std::clamp(x, 0.0f, 1.0f);
   return unsigned(std::floor(c * float(max) + 0.5f));
 }

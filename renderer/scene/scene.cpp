@@ -143,6 +143,15 @@ TextureFilter parse_filter(ObjectReader& r, const std::string& key) {
   r.fail(r.at(key), "expected \"nearest\" or \"bilinear\", got \"" + f + "\"");
 }
 
+// A path no file system takes (PATH_MAX, 4096 bytes) is said as such, not
+// looked up and quoted whole (a 100 MB "mesh" string: issue 15's second pass).
+std::string path_string(ObjectReader& r, const std::string& key) {
+  std::string p = r.string(key, "");
+  if (p.size() >= 4096)
+    r.fail(r.at(key), "a path of " + std::to_string(p.size()) + " bytes, longer than a path can be (4095 bytes)");
+  return p;
+}
+
 std::filesystem::path resolve(const std::filesystem::path& scene_file, const std::string& p) {
   if (auto cached = expand_cache_prefix(p)) return *cached;  // "${cache}/..."
   std::filesystem::path q(p);
@@ -163,11 +172,11 @@ Material parse_material(const json& j, const std::string& path, const std::files
     const json& t = r.get("texture");
     ImageTexture tex;
     if (t.is_string()) {
-      tex.file = resolve(file, t.get<std::string>());
+      tex.file = resolve(file, path_string(r, "texture"));
     } else {
       ObjectReader tr(t, r.at("texture"), file.string());
       if (!tr.has("file")) tr.fail(tr.path(), "missing key \"file\"");
-      tex.file = resolve(file, tr.string("file", ""));
+      tex.file = resolve(file, path_string(tr, "file"));
       tex.filter = parse_filter(tr, "filter");
       tr.finish();
     }
@@ -178,7 +187,7 @@ Material parse_material(const json& j, const std::string& path, const std::files
     ObjectReader br(r.get("bump"), r.at("bump"), file.string());
     BumpMap b;
     if (!br.has("file")) br.fail(br.path(), "missing key \"file\"");
-    b.file = resolve(file, br.string("file", ""));
+    b.file = resolve(file, path_string(br, "file"));
     if (const auto why = file_problem(b.file); !why.empty()) br.fail(br.at("file"), why);
     const std::string v = br.string("variant", "height");
     if (v == "height") b.variant = BumpVariant::height;
@@ -229,7 +238,7 @@ Object parse_object(const json& j, const std::string& path, const std::filesyste
   } else {
     o.kind = Object::Kind::mesh;
     MeshPlacement place;
-    const std::string mesh_path = r.string("mesh", "");
+    const std::string mesh_path = path_string(r, "mesh");
     place.file = resolve(file, mesh_path);
     place.translate = r.vec3("translate", place.translate);
     place.scale = r.positive("scale", place.scale);

@@ -1,0 +1,62 @@
+// `rayaudit render` on scenes that are large or extreme rather than
+// malformed (issue 15's second pass, HOSTILE2 F17-F20): many objects, a
+// repeated mesh, a 100 MB path, a radiance beyond a float.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "image.h"
+#include "run_rayaudit.h"
+
+namespace fs = std::filesystem;
+using ra::test::run_rayaudit;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("rayaudit-render-limits-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d / name;
+}
+
+bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == s.size() - 1; }
+
+// Two facing mirrors of reflection 2 at max_depth 256: 2^256 overflows a
+// float. An EXR would have held +inf (exit 0): refused, naming the scene
+// and the pixel. A PNG clamps it to white, as POV-Ray's float colours do.
+TEST(RenderLimitsCli, RadianceBeyondAFloatIsRefusedForExrAndWhiteInPng) {
+  const fs::path scene = scratch("mirrors.json");
+  std::ofstream(scene) << R"({"width": 4, "height": 4, "max_depth": 256, "adc_bailout": 0,
+    "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1]},
+    "objects": [{"plane": {"normal": [0, 0, 1], "offset": -1}, "material": {"reflection": 2, "color": 1}},
+                {"plane": {"normal": [0, 0, -1], "offset": -1}, "material": {"reflection": 2, "color": 1}}]})";
+  const fs::path exr = scratch("mirrors.exr");
+  const auto r = run_rayaudit("render " + scene.string() + " -o " + exr.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind(scene.string() + ": pixel (0, 0) has radiance +inf, beyond a float's range", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(exr));
+  const fs::path png = scratch("mirrors.png");
+  const auto p = run_rayaudit("render " + scene.string() + " -o " + png.string());
+  EXPECT_EQ(p.code, 0) << p.all;
+  const ra::Image img = ra::read_image(png);
+  ASSERT_EQ(img.width, 4);
+  EXPECT_EQ(img.at(0, 0)[0], 1.0f) << "+inf is white";
+}
+
+// A 100 MB mesh path: one short line (it was the whole path, 100 MB).
+TEST(RenderLimitsCli, AHugePathIsNotQuotedWhole) {
+  const fs::path scene = scratch("longpath.json");
+  std::ofstream(scene) << R"({"width": 4, "height": 4, "objects": [{"mesh": ")" << std::string(1 << 20, 'a')
+                       << R"(.obj"}]})";
+  const auto r = run_rayaudit("render " + scene.string() + " -o " + scratch("o.png").string());
+  EXPECT_EQ(r.code, 2) << r.err.substr(0, 300);
+  EXPECT_TRUE(one_line(r.err)) << r.err.substr(0, 300);
+  EXPECT_EQ(r.err, scene.string() +
+                       ": /objects/0/mesh: a path of 1048580 bytes, longer than a path can be (4095 bytes)\n");
+}
+
+}  // namespace
