@@ -65,6 +65,9 @@ struct PreparedMesh {
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
   double bs_radius = 0;
+  Vec3d lo, hi;      // the box of its vertices, padded by `pad` (the BVH's padding)
+  double pad = 0;
+  std::uint32_t one_leaf = Bvh::kEmpty;  // the BVH's only leaf, when it has one (at most 4 triangles)
   bool cull = false;  // --cull, and the mesh is closed (cull_unsafe_reason)
 };
 
@@ -117,12 +120,19 @@ struct Tracer::Impl {
     mesh_index.assign(s.objects.size(), -1);
     shadow_cache_level1.assign(s.lights.size(), -1);
     shadow_cache_other.assign(s.lights.size(), -1);
+    // A set placed by several objects (a scene repeating one mesh) is
+    // prepared once (HOSTILE2 F17: 400 placements, 400 BVHs, 3.5 GB).
+    std::map<const TriangleSet*, int> prepared;
     for (std::size_t i = 0; i < s.objects.size(); ++i) {
       if (s.objects[i].kind != Object::Kind::mesh) continue;
-      mesh_index[i] = int(opt.use_double ? meshes_d.size() : meshes_f.size());
+      const auto [it, fresh] =
+          prepared.emplace(s.objects[i].mesh.get(), int(opt.use_double ? meshes_d.size() : meshes_f.size()));
+      mesh_index[i] = it->second;
+      if (!fresh) continue;
       if (opt.use_double) meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
       else meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
     }
+    build_object_bvh();
     for (const Object& obj : s.objects) {
       if (obj.kind == Object::Kind::mesh)
         for (const Material& m : obj.mesh->materials) load_textures(m);
@@ -141,6 +151,72 @@ struct Tracer::Impl {
         if (!derivatives.count(key)) derivatives.emplace(key, height_derivatives(img));
       }
     }
+  }
+
+  // POV-Ray bounds a scene's objects automatically once there are
+  // Bounding_Threshold (3) of them; with --accel bvh so do we: a BVH over
+  // the boxes of the spheres and meshes (a lone triangle is a one-triangle
+  // mesh), planes tested for every ray. 30,000 lone triangles took 31 s at
+  // 64x64 by a loop over all objects (HOSTILE2 F18). The image is the same
+  // bits as that loop's (ties on t go to the lower object whatever the
+  // order; object_bvh = false renders the loop for the identity tests),
+  // provided every hit a kernel reports lies in its object's box:
+  //  - a mesh's box is its vertices' box padded as its own BVH's leaves
+  //    are, so it holds every leaf that BVH can visit;
+  //  - a sphere's box is padded beyond the kernels' rounding: the naive
+  //    quadratics (seeds/001, seeds/004) report false hits up to
+  //    sqrt(E) outside the sphere, E ~ 256 eps (|o| + |c|)^2 for a ray from
+  //    o, so by 2 sqrt(E) with |o|, |c| <= `reach`. A ray from farther out
+  //    (a reflection off a far plane) takes the loop instead.
+  static constexpr std::size_t kObjectBvhMin = 3;
+  Bvh object_bvh;                // over bounded[]; empty: every ray loops
+  std::vector<int> bounded;      // slot order -> object index
+  std::vector<int> unbounded;    // planes
+  double reach = 0;              // rays with |o_a| <= reach use object_bvh
+
+  bool object_bvh_for(const Vec3d& o) const {
+    return !object_bvh.nodes.empty() && max_component(abs(o)) <= reach;
+  }
+
+  void build_object_bvh() {
+    if (opt.accel != Accel::bvh || !opt.object_bvh || opt.pov_mesh_intersect) return;
+    std::vector<int> objs;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i)
+      if (scene.objects[i].kind != Object::Kind::plane) objs.push_back(int(i));
+    if (objs.size() < kObjectBvhMin) return;
+    std::vector<Vec3d> lo(objs.size()), hi(objs.size());
+    auto far = [](const Vec3d& p) { return max_component(abs(p)); };
+    reach = std::max(far(scene.camera.position), 1.0);
+    for (const PointLight& l : scene.lights) reach = std::max(reach, far(l.position));
+    for (std::size_t k = 0; k < objs.size(); ++k) {
+      const Object& o = scene.objects[std::size_t(objs[k])];
+      if (o.kind == Object::Kind::sphere) {
+        const Vec3d r{o.sphere.radius, o.sphere.radius, o.sphere.radius};
+        lo[k] = o.sphere.center - r;
+        hi[k] = o.sphere.center + r;
+      } else {
+        const int mi = mesh_index[std::size_t(objs[k])];
+        lo[k] = opt.use_double ? meshes_d[std::size_t(mi)].lo : meshes_f[std::size_t(mi)].lo;
+        hi[k] = opt.use_double ? meshes_d[std::size_t(mi)].hi : meshes_f[std::size_t(mi)].hi;
+      }
+      reach = std::max(reach, std::max(far(lo[k]), far(hi[k])));
+    }
+    const double eps = opt.use_double ? 0x1p-52 : 0x1p-23;
+    const double sphere_pad = 2 * std::sqrt(256 * eps) * 2 * reach;
+    for (std::size_t k = 0; k < objs.size(); ++k) {
+      const Object& o = scene.objects[std::size_t(objs[k])];
+      if (o.kind != Object::Kind::sphere) continue;
+      const double own = 1e-5 * std::max(2 * o.sphere.radius, far(o.sphere.center) + o.sphere.radius);
+      const double pad = std::max(own, sphere_pad);
+      lo[k] = lo[k] - Vec3d{pad, pad, pad};
+      hi[k] = hi[k] + Vec3d{pad, pad, pad};
+    }
+    object_bvh = Bvh::build(lo, hi, 0.0, objs.size() < 4096 ? 1 : opt.threads);
+    bounded.resize(object_bvh.order.size(), -1);
+    for (std::size_t slot = 0; slot < object_bvh.order.size(); ++slot)
+      if (object_bvh.order[slot] != Bvh::kNoTriangle) bounded[slot] = objs[object_bvh.order[slot]];
+    for (std::size_t i = 0; i < scene.objects.size(); ++i)
+      if (scene.objects[i].kind == Object::Kind::plane) unbounded.push_back(int(i));
   }
 
   // moller's 4-lane form answers bit for bit as its scalar one: with the
@@ -200,6 +276,9 @@ struct Tracer::Impl {
     }
     m.bs_center = (lo + hi) * 0.5;
     for (const auto& p : set.positions) m.bs_radius = std::max(m.bs_radius, length(p - m.bs_center));
+    m.pad = 1e-5 * std::max(length(hi - lo), std::max(max_component(abs(lo)), max_component(abs(hi))));
+    m.lo = lo - Vec3d{m.pad, m.pad, m.pad};
+    m.hi = hi + Vec3d{m.pad, m.pad, m.pad};
     if (opt.accel == Accel::bvh) build_bvh(m, k, lo, hi);
     return m;
   }
@@ -213,6 +292,10 @@ struct Tracer::Impl {
     const TriangleSet& set = *m.set;
     const std::size_t n = set.triangles.size();
     const double size = std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
+    // A small mesh (a scene's lone triangle) is built on this thread:
+    // starting threads for each of 30,000 would cost more than the builds
+    // (the tree is the same for every thread count).
+    const int build_threads = n < 4096 ? 1 : opt.threads;
     m.bvh = Bvh::build(
         n,
         [&](std::size_t begin, std::size_t end, Vec3d* lo, Vec3d* hi) {
@@ -222,7 +305,15 @@ struct Tracer::Impl {
             hi[i - begin] = vmax(set.positions[t.v[0]], vmax(set.positions[t.v[1]], set.positions[t.v[2]]));
           }
         },
-        1e-5 * size, opt.threads);
+        1e-5 * size, build_threads);
+    if (m.bvh.nodes.size() == 1) {
+      int leaves = 0, others = 0;
+      for (const std::uint32_t c : m.bvh.nodes[0].child) {
+        if (Bvh::is_leaf(c)) ++leaves, m.one_leaf = c;
+        else others += c != Bvh::kEmpty;
+      }
+      if (leaves != 1 || others != 0) m.one_leaf = Bvh::kEmpty;
+    }
     const std::size_t slots = m.bvh.order.size();
     if (bvh_tri4()) {
       m.tri4.reserve(slots / 4);
@@ -253,6 +344,26 @@ struct Tracer::Impl {
     m.pre = std::move(pre);
   }
 
+  // A mesh whose BVH is one leaf (a scene's lone triangle), reached through
+  // the object BVH (`boxed`: its box, the leaf's, just tested), has that
+  // leaf tested without a traversal's box tests again, which cost more
+  // than the triangle when a scene holds thousands of them. The same hits:
+  // the kernels apply the ray's window themselves.
+  template <bool kClosest, bool kFma, class T, class P, class Leaf, class Pre>
+  [[gnu::always_inline]] static inline void walk_mesh(const PreparedMesh<P>& m, bool boxed, const Vec3<T>& o,
+                                                      const Vec3<T>& d, T tmin, const T& tmax, Leaf&& leaf, Pre&& pre) {
+    if (boxed && m.one_leaf != Bvh::kEmpty) {
+      leaf(Bvh::leaf_first(m.one_leaf), Bvh::leaf_count(m.one_leaf));
+      return;
+    }
+    traverse<kClosest, kFma>(m.bvh, o, d, tmin, tmax, leaf, pre);
+  }
+  template <bool kClosest, bool kFma, class T, class P, class Leaf>
+  [[gnu::always_inline]] static inline void walk_mesh(const PreparedMesh<P>& m, bool boxed, const Vec3<T>& o,
+                                                      const Vec3<T>& d, T tmin, const T& tmax, Leaf&& leaf) {
+    walk_mesh<kClosest, kFma>(m, boxed, o, d, tmin, tmax, leaf, [](std::uint32_t) {});
+  }
+
   template <class T>
   const std::vector<PreparedMesh<T>>& meshes() const {
     if constexpr (sizeof(T) == 4) return meshes_f; else return meshes_d;
@@ -274,8 +385,8 @@ struct Tracer::Impl {
         window.tmax = T(t);
       }
     };
-    for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
-      if (only >= 0 && int(oi) != only) continue;
+    // boxed: the object BVH has just tested the object's box.
+    auto visit = [&](std::size_t oi, bool boxed) __attribute__((always_inline)) {
       const Object& o = scene.objects[oi];
       switch (o.kind) {
         case Object::Kind::sphere: {
@@ -298,7 +409,7 @@ struct Tracer::Impl {
           }
           if (opt.accel == Accel::bvh) {
             if (!m.tri4.empty()) {
-              traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+              walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
                 moller_simd::Hit4<T> h;
                 moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
                 for (int hits = h.hits; hits; hits &= hits - 1) {
@@ -309,7 +420,7 @@ struct Tracer::Impl {
               }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
               break;
             }
-            traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+            walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
               for (std::uint32_t slot = first; slot < first + count; ++slot)
                 if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
                   consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
@@ -328,6 +439,19 @@ struct Tracer::Impl {
           break;
         }
       }
+    };
+    if (only >= 0) {
+      visit(std::size_t(only), false);
+    } else if (object_bvh_for(rd.o)) {
+      for (const int oi : unbounded) visit(std::size_t(oi), false);
+      traverse<true, kFma>(object_bvh, window.o, window.d, window.tmin, window.tmax,
+                           [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+                             for (std::uint32_t slot = first; slot < first + count; ++slot)
+                               visit(std::size_t(bounded[slot]), true);
+                             return false;
+                           });
+    } else {
+      for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) visit(oi, false);
     }
     if (best.object < 0) return std::nullopt;
     return best;
@@ -397,7 +521,8 @@ struct Tracer::Impl {
   // Is anything in the ray's window? (shadow rays) Inlined as closest_impl.
   template <class T, bool kFma>
   [[gnu::always_inline]] inline bool occluded_impl(const Ray<T>& r) const {
-    for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
+    // Is object oi in the ray's window?
+    auto visit = [&](std::size_t oi, bool boxed) __attribute__((always_inline)) -> bool {
       const Object& o = scene.objects[oi];
       switch (o.kind) {
         case Object::Kind::sphere:
@@ -417,13 +542,13 @@ struct Tracer::Impl {
           if (opt.accel == Accel::bvh) {
             bool hit = false;
             if (!m.tri4.empty()) {
-              traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+              walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
                 moller_simd::Hit4<T> h;
                 moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
                 return hit = h.hits != 0;
               }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
             } else {
-              traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+              walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                 for (std::uint32_t slot = first; slot < first + count; ++slot)
                   if (k.any_pre(r, m.pre.data() + slot * m.stride, m.cull)) return hit = true;
                 return false;
@@ -441,7 +566,22 @@ struct Tracer::Impl {
           break;
         }
       }
+      return false;
+    };
+    if (object_bvh_for(Vec3d(r.o))) {
+      for (const int oi : unbounded)
+        if (visit(std::size_t(oi), false)) return true;
+      bool hit = false;
+      traverse<false, kFma>(object_bvh, r.o, r.d, r.tmin, r.tmax,
+                            [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+                              for (std::uint32_t slot = first; slot < first + count; ++slot)
+                                if (visit(std::size_t(bounded[slot]), true)) return hit = true;
+                              return false;
+                            });
+      return hit;
     }
+    for (std::size_t oi = 0; oi < scene.objects.size(); ++oi)
+      if (visit(oi, false)) return true;
     return false;
   }
 

@@ -26,6 +26,10 @@ struct RenderOptions {
   int threads = 0;          // 0: all cores
   int samples_per_axis = 1; // n x n samples per pixel, averaged
   bool progress = true;     // a progress line on a terminal (stderr)
+  // With accel bvh, a scene of 3 or more spheres and meshes finds them
+  // through a BVH over their boxes (POV-Ray's automatic bounding); false:
+  // a loop over every object. The same image either way (render_test).
+  bool object_bvh = true;
   // Use AVX2 where the CPU has it (false: the baseline x86-64 SSE2 paths;
   // both give the same bits, which the Accel tests check).
   bool simd = true;
