@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/full_disk.h"
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;
@@ -150,6 +151,42 @@ TEST_F(GoldenDataCli, ManifestEntriesAreReadStrictly) {
     EXPECT_TRUE(one_line(r.err)) << r.err;
     EXPECT_EQ(r.err.rfind((root / "golden" / "manifest.json").string() + ": " + c.says, 0), 0u) << r.err;
   }
+}
+
+// F37: bless on a full disk replaced the golden image, then failed to
+// write the manifest: image and manifest disagreed. All are renamed
+// together after the last is written, so exit 2 leaves golden/ as it was.
+TEST(GoldenFullDiskCli, BlessOnAFullDiskLeavesGoldenAsItWas) {
+  ra::test::FullDisk disk(32 * 1024);
+  if (!disk.ok()) GTEST_SKIP() << disk.why_not();
+  const fs::path root = disk.dir() / "repo";
+  fs::create_directories(root / "scenes");
+  for (const char* n : {"a", "b"})
+    std::ofstream(root / "scenes" / (std::string(n) + ".json"))
+        << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}, "material": {"color": )"
+        << (n[0] == 'a' ? "0.5" : "0.25") << "}}]}\n";
+  ASSERT_EQ(run_rayaudit("golden bless --root " + root.string()).code, 0);
+  fs::copy_file(root / "golden" / "b.png", root / "golden" / "a.png", fs::copy_options::overwrite_existing);
+  const std::string image = slurp(root / "golden" / "a.png"), manifest = slurp(root / "golden" / "manifest.json");
+  // Fill the disk with pages, then free one: one temporary fits, not two.
+  int pages = 0;
+  for (;; ++pages) {
+    std::ofstream f(disk.dir() / ("fill" + std::to_string(pages)), std::ios::binary);
+    f << std::string(4096, 'x');
+    f.flush();
+    if (!f) break;
+  }
+  ASSERT_GT(pages, 0);
+  fs::remove(disk.dir() / "fill0");
+  fs::remove(disk.dir() / ("fill" + std::to_string(pages)));
+  const auto r = run_rayaudit("golden bless a --root " + root.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(root / "golden" / "a.png"), image);
+  EXPECT_EQ(slurp(root / "golden" / "manifest.json"), manifest);
+  for (const auto& e : fs::directory_iterator(root / "golden"))
+    EXPECT_NE(e.path().filename().string().rfind(".tmp-", 0), 0u) << "left behind: " << e.path();
 }
 
 }  // namespace
