@@ -59,4 +59,61 @@ TEST(RenderLimitsCli, AHugePathIsNotQuotedWhole) {
                        ": /objects/0/mesh: a path of 1048580 bytes, longer than a path can be (4095 bytes)\n");
 }
 
+// AddressSanitizer reserves terabytes of address space: tests that limit it
+// with prlimit --as cannot run under the asan preset.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
+// F17: one mesh placed 400 times was loaded and given a BVH 400 times (a
+// 69,666-triangle mesh: 3.5 GB). A 20,000-triangle mesh placed 400 times
+// (about 1.6 GB as 400 copies) now renders under a 1 GB address-space limit.
+TEST(RenderLimitsCli, AMeshPlaced400TimesIsLoadedOnce) {
+  if (kSanitized) GTEST_SKIP() << "prlimit --as under ASan";
+  const fs::path mesh = scratch("grid.obj");
+  {
+    std::ofstream out(mesh);
+    const int n = 100;  // (n x n) quads, 2 triangles each
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) out << "v " << i * 0.01 << " " << j * 0.01 << " " << (i * j % 7) * 0.001 << "\n";
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const int a = j * (n + 1) + i + 1, b = a + 1, c = a + n + 1, d = c + 1;
+        out << "f " << a << " " << b << " " << d << "\nf " << a << " " << d << " " << c << "\n";
+      }
+  }
+  const fs::path scene = scratch("m400.json");
+  {
+    std::ofstream out(scene);
+    out << R"({"width": 8, "height": 8, "objects": [)";
+    for (int i = 0; i < 400; ++i) out << (i ? ", " : "") << R"({"mesh": "grid.obj"})";
+    out << "]}\n";
+  }
+  const fs::path png = scratch("m400.png");
+  const auto r = run_rayaudit("render " + scene.string() + " -o " + png.string(), "prlimit --as=1000000000 --");
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(png));
+}
+
+// F18: 10,000 spheres were intersected by a loop over all of them (15 s at
+// 320x240); through the object BVH they are a fraction of a second. Under a
+// 20 s CPU limit (a bound against runaway, not a timing), on one thread.
+TEST(RenderLimitsCli, TenThousandSpheresAreBoundedByTheObjectBvh) {
+  const fs::path scene = scratch("sp10k.json");
+  {
+    std::ofstream out(scene);
+    out << R"({"width": 320, "height": 240, "objects": [)";
+    for (int i = 0; i < 10000; ++i)
+      out << (i ? ", " : "") << R"({"sphere": {"center": [)" << i * 0.001 << R"(, 0, 0], "radius": 0.001}})";
+    out << "]}\n";
+  }
+  const fs::path png = scratch("sp10k.png");
+  const auto r = run_rayaudit("render " + scene.string() + " -o " + png.string() + " --threads 1",
+                              "prlimit --cpu=20 --");
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(png));
+}
+
 }  // namespace
