@@ -168,26 +168,64 @@ struct Tracer::Impl {
   //    sqrt(E) outside the sphere, E ~ 256 eps (|o| + |c|)^2 for a ray from
   //    o, so by 2 sqrt(E) with |o|, |c| <= `reach`. A ray from farther out
   //    (a reflection off a far plane) takes the loop instead.
+  //  - lone triangles (one-triangle meshes) are not boxes of their own but
+  //    one "soup": a mesh of all of them with its own BVH (leaves of 4,
+  //    contiguous), each triangle mapped back to its object. The kernels
+  //    see the same vertices and window, so the same hits; 30,000 of them
+  //    as objects cost 12 times as much as in one mesh (a cache miss per
+  //    object), as a soup about the same.
   static constexpr std::size_t kObjectBvhMin = 3;
-  Bvh object_bvh;                // over bounded[]; empty: every ray loops
+  bool objects_bounded = false;  // the object BVH (and soup) in use
+  Bvh object_bvh;                // over bounded[]
   std::vector<int> bounded;      // slot order -> object index
   std::vector<int> unbounded;    // planes
   double reach = 0;              // rays with |o_a| <= reach use object_bvh
+  TriangleSet soup_set;          // the lone triangles' vertices, 3 each
+  std::vector<int> soup_object;  // soup triangle -> object
+  PreparedMesh<float> soup_f;
+  PreparedMesh<double> soup_d;
 
-  bool object_bvh_for(const Vec3d& o) const {
-    return !object_bvh.nodes.empty() && max_component(abs(o)) <= reach;
+  template <class T>
+  const PreparedMesh<T>& soup() const {
+    if constexpr (sizeof(T) == 4) return soup_f; else return soup_d;
   }
+
+  bool object_bvh_for(const Vec3d& o) const { return objects_bounded && max_component(abs(o)) <= reach; }
 
   void build_object_bvh() {
     if (opt.accel != Accel::bvh || !opt.object_bvh || opt.pov_mesh_intersect) return;
-    std::vector<int> objs;
-    for (std::size_t i = 0; i < scene.objects.size(); ++i)
-      if (scene.objects[i].kind != Object::Kind::plane) objs.push_back(int(i));
-    if (objs.size() < kObjectBvhMin) return;
-    std::vector<Vec3d> lo(objs.size()), hi(objs.size());
+    std::vector<int> objs, lone;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      const Object& o = scene.objects[i];
+      if (o.kind == Object::Kind::plane) continue;
+      const std::size_t mi = std::size_t(mesh_index[i]);
+      const bool one = o.kind == Object::Kind::mesh && o.mesh->triangles.size() == 1 &&
+                       !(opt.use_double ? meshes_d[mi].cull : meshes_f[mi].cull);
+      (one ? lone : objs).push_back(int(i));
+    }
+    if (objs.size() + lone.size() < kObjectBvhMin) return;
+    objects_bounded = true;
     auto far = [](const Vec3d& p) { return max_component(abs(p)); };
     reach = std::max(far(scene.camera.position), 1.0);
     for (const PointLight& l : scene.lights) reach = std::max(reach, far(l.position));
+    for (const int i : lone) {
+      const TriangleSet& set = *scene.objects[std::size_t(i)].mesh;
+      const auto& t = set.triangles[0];
+      const int base = int(soup_set.positions.size());
+      for (int v = 0; v < 3; ++v) {
+        soup_set.positions.push_back(set.positions[std::size_t(t.v[std::size_t(v)])]);
+        reach = std::max(reach, far(soup_set.positions.back()));
+      }
+      soup_set.triangles.push_back(MeshTriangle3{{base, base + 1, base + 2}, {-1, -1, -1}, {-1, -1, -1}, 0});
+      soup_object.push_back(i);
+    }
+    soup_set.name = "lone triangles";
+    soup_set.materials = {Material{}};
+    if (!lone.empty()) {
+      if (opt.use_double) soup_d = prepare<double>(soup_set, false);
+      else soup_f = prepare<float>(soup_set, false);
+    }
+    std::vector<Vec3d> lo(objs.size()), hi(objs.size());
     for (std::size_t k = 0; k < objs.size(); ++k) {
       const Object& o = scene.objects[std::size_t(objs[k])];
       if (o.kind == Object::Kind::sphere) {
@@ -211,7 +249,7 @@ struct Tracer::Impl {
       lo[k] = lo[k] - Vec3d{pad, pad, pad};
       hi[k] = hi[k] + Vec3d{pad, pad, pad};
     }
-    object_bvh = Bvh::build(lo, hi, 0.0, objs.size() < 4096 ? 1 : opt.threads);
+    if (!objs.empty()) object_bvh = Bvh::build(lo, hi, 0.0, objs.size() < 4096 ? 1 : opt.threads);
     bounded.resize(object_bvh.order.size(), -1);
     for (std::size_t slot = 0; slot < object_bvh.order.size(); ++slot)
       if (object_bvh.order[slot] != Bvh::kNoTriangle) bounded[slot] = objs[object_bvh.order[slot]];
@@ -241,7 +279,7 @@ struct Tracer::Impl {
   }
 
   template <class T>
-  PreparedMesh<T> prepare(const TriangleSet& set) const {
+  PreparedMesh<T> prepare(const TriangleSet& set, bool cull_check = true) const {
     PreparedMesh<T> m;
     m.set = &set;
     const auto& k = tri_method->triangle<T>();
@@ -269,7 +307,7 @@ struct Tracer::Impl {
       lo = vmin(lo, p);
       hi = vmax(hi, p);
     }
-    if (opt.cull) {
+    if (opt.cull && cull_check) {
       const std::string why = cull_unsafe_reason(set);
       m.cull = why.empty();
       if (!m.cull) std::fprintf(stderr, "warning: %s: --cull not applied to this mesh: %s\n", set.name.c_str(), why.c_str());
@@ -444,6 +482,27 @@ struct Tracer::Impl {
       visit(std::size_t(only), false);
     } else if (object_bvh_for(rd.o)) {
       for (const int oi : unbounded) visit(std::size_t(oi), false);
+      if (const auto& m = soup<T>(); !m.bvh.nodes.empty()) {
+        if (!m.tri4.empty()) {
+          traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+            moller_simd::Hit4<T> h;
+            moller_simd::hit4(window, m.tri4[first / 4], false, h);
+            for (int hits = h.hits; hits; hits &= hits - 1) {
+              const int l = __builtin_ctz(unsigned(hits));
+              consider(double(h.t[l]), soup_object[m.bvh.order[first + l]], 0, double(h.b1[l]), double(h.b2[l]));
+            }
+            return false;
+          }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+        } else {
+          const auto& k = tri_method->triangle<T>();
+          traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+            for (std::uint32_t slot = first; slot < first + count; ++slot)
+              if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, false))
+                consider(double(h->t), soup_object[m.bvh.order[slot]], 0, double(h->b1), double(h->b2));
+            return false;
+          });
+        }
+      }
       traverse<true, kFma>(object_bvh, window.o, window.d, window.tmin, window.tmax,
                            [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                              for (std::uint32_t slot = first; slot < first + count; ++slot)
@@ -572,6 +631,23 @@ struct Tracer::Impl {
       for (const int oi : unbounded)
         if (visit(std::size_t(oi), false)) return true;
       bool hit = false;
+      if (const auto& m = soup<T>(); !m.bvh.nodes.empty()) {
+        if (!m.tri4.empty()) {
+          traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+            moller_simd::Hit4<T> h;
+            moller_simd::hit4(r, m.tri4[first / 4], false, h);
+            return hit = h.hits != 0;
+          }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+        } else {
+          const auto& k = tri_method->triangle<T>();
+          traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+            for (std::uint32_t slot = first; slot < first + count; ++slot)
+              if (k.any_pre(r, m.pre.data() + slot * m.stride, false)) return hit = true;
+            return false;
+          });
+        }
+        if (hit) return true;
+      }
       traverse<false, kFma>(object_bvh, r.o, r.d, r.tmin, r.tmax,
                             [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                               for (std::uint32_t slot = first; slot < first + count; ++slot)
