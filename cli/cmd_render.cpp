@@ -60,9 +60,10 @@ void check_finite(const ra::Scene& scene, const ra::Image& img, bool exr) {
         throw ra::InputError(ra::located(
             scene.file.string(), 0,
             "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") has radiance " + what +
-                (std::isnan(v) ? " (an overflowing reflection times a zero channel)" : ", beyond a float's range") +
-                ": reflection above 1 compounds over max_depth " + std::to_string(scene.max_depth) +
-                " levels; lower them" + (exr ? " (a PNG output clamps +inf to white, as POV-Ray does)" : "")));
+                (std::isnan(v) ? ": a texture holds NaN, or an overflowing reflection met a zero channel"
+                               : ", beyond a float's range: reflection above 1 compounds over max_depth " +
+                                     std::to_string(scene.max_depth) +
+                                     " levels; lower them (a PNG output clamps +inf to white, as POV-Ray does)")));
       }
 }
 

@@ -116,4 +116,32 @@ TEST(RenderLimitsCli, TenThousandSpheresAreBoundedByTheObjectBvh) {
   EXPECT_TRUE(fs::exists(png));
 }
 
+// F28: under an address-space limit of 410-450 MB every image command
+// aborted (134), crashed (139) or hung inside dlopen, where threads
+// OpenImageIO's libraries start were refused; at 460-520 MB a valid texture
+// was "cannot be allocated". Now one line naming the limit, before dlopen.
+TEST(RenderLimitsCli, AnAddressSpaceLimitTooLowForTheImageModuleIsOneLine) {
+  if (kSanitized) GTEST_SKIP() << "prlimit --as under ASan";
+  const std::string src = RAYAUDIT_SOURCE_DIR;
+  const fs::path scene = scratch("textured.json");
+  std::ofstream(scene) << R"({"width": 8, "height": 8, "objects": [{"mesh": ")" << src
+                       << R"(/scenes/meshes/quad.obj", "material": {"texture": ")" << src
+                       << R"(/scenes/textures/uv-grid.png"}}]})";
+  const fs::path png = scratch("textured.png");
+  for (const char* limit : {"300000000", "430000000", "450000000", "520000000"}) {
+    const auto r = run_rayaudit("render " + scene.string() + " -o " + png.string(),
+                                std::string("timeout -s KILL 60 prlimit --as=") + limit + " --");
+    EXPECT_EQ(r.code, 2) << limit << ": " << r.all;
+    EXPECT_TRUE(one_line(r.err)) << limit << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("rayaudit: the image module (OpenImageIO) needs about 560 MB of address space to load, "
+                          "but the limit (",
+                          0),
+              0u)
+        << r.err;
+    EXPECT_FALSE(fs::exists(png));
+  }
+  const auto ok = run_rayaudit("render " + scene.string() + " -o " + png.string(), "prlimit --as=700000000 --");
+  EXPECT_EQ(ok.code, 0) << ok.all;
+}
+
 }  // namespace

@@ -3,8 +3,12 @@
 #include "image_module.h"
 
 #include <dlfcn.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
+#include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <filesystem>
 #include <mutex>
 #include <string>
@@ -31,7 +35,31 @@ std::vector<std::string> candidates() {
   return out;
 }
 
+// Address space OpenImageIO needs to load and start: its libraries, and the
+// threads log4cplus starts while the module is opened (each with a stack and
+// a malloc arena), which abort, crash or hang inside dlopen when the system
+// refuses them; with a little less, a valid texture's read failed as
+// "cannot be allocated" (HOSTILE2 F28). Measured on Debian 12: an 8x8
+// textured render needs about 525 MB beside the 10 MB mapped before; with a
+// margin, 560 MB. Refused before dlopen, naming the limit.
+constexpr std::uint64_t kModuleAddressSpace = std::uint64_t(560) << 20;
+
+void check_address_space() {
+  rlimit as{};
+  if (::getrlimit(RLIMIT_AS, &as) != 0 || as.rlim_cur == RLIM_INFINITY) return;
+  std::uint64_t pages = 0;
+  std::ifstream("/proc/self/statm") >> pages;
+  const std::uint64_t mapped = pages * std::uint64_t(::sysconf(_SC_PAGESIZE));
+  const std::uint64_t left = as.rlim_cur > mapped ? as.rlim_cur - mapped : 0;
+  if (left < kModuleAddressSpace)
+    throw InputError("rayaudit: the image module (OpenImageIO) needs about " +
+                     std::to_string(kModuleAddressSpace >> 20) + " MB of address space to load, but the limit (" +
+                     std::to_string(as.rlim_cur >> 20) + " MB, `ulimit -v` / RLIMIT_AS) leaves " +
+                     std::to_string(left >> 20) + " MB: raise it");
+}
+
 const Api* load() {
+  check_address_space();
   std::string tried;
   for (const std::string& path : candidates()) {
     const bool by_name = path.find('/') == std::string::npos;

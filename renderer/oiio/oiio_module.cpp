@@ -154,6 +154,17 @@ int rgb_png(const char* source, std::vector<unsigned char>* out, std::string* er
 }  // namespace
 
 extern "C" __attribute__((visibility("default"))) const Api* rayaudit_image_module_api() {
+  // OpenImageIO and OpenEXR start thread pools of their own (one thread a
+  // core, each with a stack and a malloc arena of address space), which
+  // abort or hang when the system refuses a thread (under an address-space
+  // limit of 410-450 MB: HOSTILE2 F28). Our images are small (textures,
+  // goldens, one render): each call works on the calling thread.
+  static const bool single = [] {
+    OIIO::attribute("threads", 1);
+    OIIO::attribute("exr_threads", -1);
+    return true;
+  }();
+  (void)single;
   static const Api api{ra::image_module::kVersion, sizeof(Api), encode_png, write_exr, open, read, close,
                        compare, absdiff, rgb_png};
   return &api;
