@@ -11,8 +11,9 @@
 //   (`-s 2 2 1 -bm 0.5 my tex.png` is "my tex.png" with bump_multiplier 0.5).
 //   Backslashes become '/', relative names are resolved against the .mtl's
 //   directory, a missing file is a warning.
-// - Statements before the first newmtl, unknown ones and `newmtl` without
-//   a name (Blender writes it; the material is named "") are warnings.
+// - Statements before the first newmtl and unknown ones are warnings.
+//   `newmtl` without a name is an error at its line (it was two warnings
+//   and a material no `usemtl` can name on purpose).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -147,7 +148,7 @@ struct MtlParser {
     while (!at_separator(p, se)) ++p;
     if (kw(k, p, "newmtl")) {
       std::string n(rest_as_name(p, se));
-      if (n.empty()) warnings.push_back(located(name, line, "newmtl without a name (material named '')"));
+      if (n.empty()) w.fail(line, "newmtl without a material name");
       out.emplace_back();
       out.back().name = std::move(n);
       has_d.push_back(false);

@@ -385,6 +385,7 @@ struct ChunkParser {
   long iv = 0, ivt = 0, ivn = 0;  // statements of each kind seen so far in the chunk
   long itri = 0;                   // triangles written (parallel)
   const char* here = nullptr;      // statement being parsed (serial: capacity estimates)
+  const char* stmt = "face";       // the statement whose indices are parsed, for messages
   std::vector<Corner> poly;
   std::vector<Vec3d> pts;
   std::vector<std::array<int, 3>> ears;
@@ -595,8 +596,8 @@ struct ChunkParser {
       case Kw::VN: parse_vn(kend, se, line); return;
       case Kw::F: parse_f(kend, se, line); return;
       case Kw::VP: ++c.vp; return;
-      case Kw::L: ++c.l; return;
-      case Kw::P: ++c.p; return;
+      case Kw::L: parse_lp(kend, se, line, "line", 2), ++c.l; return;
+      case Kw::P: parse_lp(kend, se, line, "point", 1), ++c.p; return;
       case Kw::O: c.cur_object = parse_name(c.objects, kend, se, line), tags_changed = true; return;
       case Kw::Usemtl: c.cur_mat = parse_name(c.mats, kend, se, line); return;
       case Kw::G: c.cur_group = parse_group(kend, se, line), tags_changed = true; return;
@@ -679,7 +680,7 @@ struct ChunkParser {
       // then passed and read before the first vertex; issue 15).
       if (i < -static_cast<long long>(count))
         w.fail(line, std::string("relative ") + kind + " index " + std::to_string(i) +
-                         " reaches before the first one (" + std::to_string(count) + " defined before this face)");
+                         " reaches before the first one (" + std::to_string(count) + " defined before this " + stmt + ")");
       out = int(count + i);
     }
     return q;
@@ -703,7 +704,7 @@ struct ChunkParser {
       if (read_keyword(s, e, &kend) == want && ++n == i)
         w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is defined later, at line " +
                          std::to_string(ln) + ": forward references are not allowed (" + std::to_string(count) +
-                         " defined before this face)");
+                         " defined before this " + stmt + ")");
       ln += extra + 1;
       p = e + 1;
     }
@@ -711,6 +712,27 @@ struct ChunkParser {
     const char* single = kind[0] == 'v' ? " vertex" : kind[0] == 't' ? " texture coordinate" : " normal";
     w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is past the end: the file has only " +
                      std::to_string(n) + (n == 1 ? single : plural));
+  }
+
+  // `l v1[/vt1] v2[/vt2] ...` and `p v1 v2 ...`: not rendered, but their
+  // indices are checked as a face's are (an index past the end or 0 was
+  // skipped silently). `what` names the statement, `min` its fewest vertices.
+  void parse_lp(const char* p, const char* se, long line, const char* what, int min) {
+    const long nv = c.base_v + iv, nvt = c.base_vt + ivt;
+    stmt = what;
+    int n = 0, unused = 0;
+    for (;;) {
+      p = skip_ws(p, se);
+      if (p >= se || *p == '#') break;
+      p = parse_index(p, se, nv, "vertex", line, unused);
+      if (what[0] == 'l' && p < se && *p == '/') p = parse_index(p + 1, se, nvt, "texture", line, unused);
+      if (!at_separator(p, se)) w.fail(line, "malformed " + std::string(what) + " vertex near '" + token_text(p, se) + "'");
+      ++n;
+    }
+    stmt = "face";
+    if (n < min)
+      w.fail(line, std::string(what) + " statement with " + std::to_string(n) + " vertices (at least " +
+                       std::to_string(min) + " needed)");
   }
 
   void parse_f(const char* p, const char* se, long line) {

@@ -21,12 +21,15 @@ struct Tokens {
   long line = 1;
 
   [[noreturn]] void fail(const std::string& msg) const { throw InputError(located(name, line, msg)); }
-  // Skips spaces (and newlines when `lines`), and '#' comments.
+  // A line ends at \n, \r\n or a lone \r (classic Mac OS): a CR-only file
+  // was one line, its errors all at line 1 (issue 15's fourth pass).
+  bool eol(const char* q) const { return *q == '\n' || (*q == '\r' && (q + 1 == e || q[1] != '\n')); }
+  // Skips spaces (and line ends when `lines`), and '#' comments.
   void skip(bool lines) {
     for (;;) {
-      while (p < e && (*p == ' ' || *p == '\t' || *p == '\r' || (lines && *p == '\n'))) line += (*p++ == '\n');
+      while (p < e && (*p == ' ' || *p == '\t' || (*p == '\r' && !eol(p)) || (lines && eol(p)))) line += eol(p++);
       if (p < e && *p == '#') {
-        while (p < e && *p != '\n') ++p;
+        while (p < e && !eol(p)) ++p;
         continue;
       }
       return;
@@ -34,10 +37,10 @@ struct Tokens {
   }
   bool at_eol() {
     skip(false);
-    return p >= e || *p == '\n';
+    return p >= e || eol(p);
   }
   void next_line() {
-    while (p < e && *p != '\n') ++p;
+    while (p < e && !eol(p)) ++p;
     if (p < e) ++p, ++line;
   }
   std::string_view word() {
@@ -45,6 +48,11 @@ struct Tokens {
     const char* b = p;
     while (p < e && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n') ++p;
     return {b, size_t(p - b)};
+  }
+  // True at the end of the text (after blank lines and comments).
+  bool at_end() {
+    skip(true);
+    return p >= e;
   }
   // The next number on this line (OFF's lines are records).
   template <class T>
@@ -86,11 +94,13 @@ struct PlyProp {
   PlyType type;
   bool list = false;
   PlyType count_type = PlyType::U8;
+  long line = 0;  // its header line, for errors about the property itself
 };
 struct PlyElement {
   std::string name;
   long count;
   std::vector<PlyProp> props;
+  long line = 0;  // its header line
 };
 
 bool ply_type(std::string_view s, PlyType& t) {
@@ -205,6 +215,7 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       t.next_line();
     } else if (k == "element") {
       PlyElement el;
+      el.line = t.line;
       el.name = std::string(t.word());
       el.count = t.number<long>("element count");
       if (el.count < 0 || el.count > (1L << 31)) t.fail("element count out of range");
@@ -213,6 +224,7 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
     } else if (k == "property") {
       if (elements.empty()) t.fail("property before any element");
       PlyProp pr;
+      pr.line = t.line;
       auto ty = t.word();
       if (ty == "list") {
         pr.list = true;
@@ -253,10 +265,14 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       if (n == "z") iz = int(i);
       if (el.props[i].list && (n == "vertex_indices" || n == "vertex_index")) ilist = int(i);
     }
-    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) t.fail("vertex element without x, y, z");
+    // Errors of the header name its line, not the first data line.
+    if (is_vertex && (ix < 0 || iy < 0 || iz < 0))
+      throw InputError(located(name, el.line, "vertex element without x, y, z"));
     for (int c : {ix, iy, iz})  // a list named x read its count as the coordinate
-      if (is_vertex && el.props[size_t(c)].list) t.fail("vertex property '" + el.props[size_t(c)].name + "' is a list");
-    if (is_face && ilist < 0) t.fail("face element without vertex_indices");
+      if (is_vertex && el.props[size_t(c)].list)
+        throw InputError(located(name, el.props[size_t(c)].line, "vertex property '" + el.props[size_t(c)].name + "' is a list"));
+    if (is_face && ilist < 0)
+      throw InputError(located(name, el.line, "face element without a vertex_indices (or vertex_index) list property"));
     // Reserve no more than the data can hold (a count alone is not trusted).
     if (is_vertex) m.positions.reserve(std::min(size_t(el.count), size_t(br.e - br.p) / min_row_bytes(el, format) + 1));
     for (long r = 0; r < el.count; ++r) {
@@ -330,6 +346,41 @@ static bool off_magic(std::string_view m) {
   return m.empty();
 }
 
+// What each vertex line carries after x y z, as the magic promises: N a
+// normal (3 values), C a colour (RGB or RGBA: 3 or 4), ST a texture
+// coordinate (2). A NOFF without its normals was read as a plain OFF.
+struct OffExtras {
+  int normal = 0, colour = 0, st = 0;
+};
+static OffExtras off_extras(std::string_view m) {
+  OffExtras x;
+  if (m.rfind("ST", 0) == 0) x.st = 2, m.remove_prefix(2);
+  if (!m.empty() && m[0] == 'C') x.colour = 3, m.remove_prefix(1);
+  if (!m.empty() && m[0] == 'N') x.normal = 3;
+  return x;
+}
+
+// The values after x y z on a vertex line: all numbers, and as many as the
+// magic promises (a colour may have 3 or 4). A plain OFF's extra values
+// are ignored as before (some files carry unannounced colours).
+static void check_off_extras(Tokens& t, const OffExtras& x, std::string_view magic) {
+  if (!x.normal && !x.colour && !x.st) return;
+  int n = 0;
+  while (!t.at_eol()) {
+    t.number<double>("vertex value");
+    ++n;
+  }
+  const int base = x.normal + x.colour + x.st;
+  if (n == base || (x.colour && n == base + 1)) return;
+  std::string want;
+  auto add = [&](const char* s) { want += (want.empty() ? "" : ", ") + std::string(s); };
+  if (x.normal) add("a normal (3 values)");
+  if (x.colour) add("a colour (3 or 4 values)");
+  if (x.st) add("a texture coordinate (2 values)");
+  t.fail(std::string(magic) + " vertex needs x y z and " + want + " (" + std::to_string(n) +
+         " values after x y z)");
+}
+
 PolyMesh parse_off(std::string_view text, const std::string& name) {
   Tokens t{text.data(), text.data() + text.size(), name};
   const std::string_view magic = t.word();
@@ -340,6 +391,8 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
     if (t.e - q >= 6 && std::string_view(q, 6) == "BINARY") t.fail("binary OFF is not supported (ASCII OFF only)");
   }
   const long nv = t.number<long>("vertex count"), nf = t.number<long>("face count");
+  // The edge count may be missing ("3 1"): a face would otherwise be read as it.
+  if (t.at_eol()) t.fail("counts line needs vertices, faces and edges (found 2 numbers)");
   t.number<long>("edge count");
   if (nv < 0 || nf < 0 || nv > (1L << 31) || nf > (1L << 31)) t.fail("counts out of range");
   // Each vertex or face takes more than a byte: counts beyond the bytes that
@@ -352,19 +405,23 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
   t.next_line();
   PolyMesh m;
   m.positions.reserve(std::min(size_t(nv), size_t(left / 5) + 1));
+  const OffExtras extras = off_extras(magic);
   for (long i = 0; i < nv; ++i) {
-    t.skip(true);
+    // Fewer rows than the counts: said at the line where the file ends, not
+    // as "malformed face size ''" past it.
+    if (t.at_end()) t.fail("file ends after " + std::to_string(i) + " of the " + std::to_string(nv) + " vertices the counts declare");
     Vec3d p;
     p.x = t.number_on_line<double>("x coordinate");
     p.y = t.number_on_line<double>("y coordinate");
     p.z = t.number_on_line<double>("z coordinate");
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) t.fail("coordinate not finite");
+    check_off_extras(t, extras, magic);
     m.positions.push_back(p);
     t.next_line();
   }
   m.face_start.push_back(0);
   for (long f = 0; f < nf; ++f) {
-    t.skip(true);
+    if (t.at_end()) t.fail("file ends after " + std::to_string(f) + " of the " + std::to_string(nf) + " faces the counts declare");
     const long n = t.number<long>("face size");
     if (n < 3 || n > 1000000) t.fail("face with " + std::to_string(n) + " vertices");
     for (long j = 0; j < n; ++j) {
