@@ -17,6 +17,7 @@
 #include "command.h"
 #include "errors.h"
 #include "io/input_file.h"
+#include "io/text_lines.h"
 #include "registry.h"
 
 namespace {
@@ -193,7 +194,7 @@ void check_golden(const fs::path& f) {
 void check_stages(const fs::path& f) {
   std::istringstream in(read_file(f));
   std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
+  for (int n = 1; ra::read_text_line(in, line); ++n) {  // \n, \r\n and a lone \r
     if (line.empty()) continue;
     const auto tab = line.rfind('\t');
     char* end = nullptr;

@@ -257,3 +257,7 @@ put('obj', 'l_index_zero.obj', TRI + 'l 0 1\nf 1 2 3\n')
 put('obj', 'p_relative_too_far.obj', TRI + 'f 1 2 3\np -4\n')
 put('obj', 'l_texture_past_end.obj', TRI + 'vt 0 0\nf 1 2 3\nl 1/1 2/2\n')
 put('obj', 'l_one_vertex.obj', TRI + 'f 1 2 3\nl 1\n')
+# CR-only line ends (classic Mac OS) are line ends: errors at the right line.
+put('scene', 'cr_only_line_ends.json', '{\r"width": 8,\r"height": 8,\r"objects": [}\r')
+put('csv', 'cr_only_line_ends.csv', 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\r0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\r0,0,x,0,0,1,0,0,1,1,0,1,0,1,1\r')
+put('csv', 'mixed_line_ends.csv', 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\r\n0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\r0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\n0,0,0,0,0,1,0,0,1,1,0,1,0,1\r\n')

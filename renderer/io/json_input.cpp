@@ -17,9 +17,12 @@ namespace {
 
 using json = nlohmann::json;
 
+// Lines end at \n, \r\n or a lone \r (a CR-only file put every error at
+// line 1: issue 15's fourth pass).
 long line_at(const std::string& text, std::size_t byte) {
   long line = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) line += text[i] == '\n';
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i)
+    line += text[i] == '\n' || (text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'));
   return line;
 }
 
