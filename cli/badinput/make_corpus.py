@@ -261,3 +261,8 @@ put('obj', 'l_one_vertex.obj', TRI + 'f 1 2 3\nl 1\n')
 put('scene', 'cr_only_line_ends.json', '{\r"width": 8,\r"height": 8,\r"objects": [}\r')
 put('csv', 'cr_only_line_ends.csv', 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\r0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\r0,0,x,0,0,1,0,0,1,1,0,1,0,1,1\r')
 put('csv', 'mixed_line_ends.csv', 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\r\n0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\r0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\n0,0,0,0,0,1,0,0,1,1,0,1,0,1\r\n')
+# The settings a golden records are checked as render checks its flags, at their line.
+GS = '{\n  "goldens": [\n    {\n      ' + GE + '"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": 8, "height": 8,\n      "settings": {\n        "triangle_method": "moller",\n        "spp": %s\n      }\n    }\n  ]\n}\n'
+put('golden', 'spp_2.json', GS % '2')
+put('golden', 'spp_huge.json', GS % '1000000')
+put('golden', 'triangle_method_unknown.json', GS.replace('"moller"', '"mollerr"') % '1')
