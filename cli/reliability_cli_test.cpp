@@ -467,3 +467,29 @@ TEST(ReliabilityCli, CompareRandomOutWithAMissingParentIsRefused) {
 }
 
 }  // namespace
+
+// Issue 15's fourth pass: `audit --json ""` wrote nothing and exited 0; every
+// option given an empty value is refused by name before any work.
+TEST(ReliabilityCli, EmptyOptionValuesAreRefusedByName) {
+  const fs::path dir = scratch("empty-values");
+  fs::create_directories(dir);
+  const std::string scene = kScenes + "/doc002-tetrahedron.json";
+  const std::pair<std::string, std::string> cases[] = {
+      {"audit --methods moller --families edge --rays 10 --json ''", "--json"},
+      {"audit --methods moller --families edge --rays 10 --csv ''", "--csv"},
+      {"audit --methods moller --families edge --rays 10 --export-cases ''", "--export-cases"},
+      {"render " + scene + " -o ''", "--output"},
+      {"compare " + scene + " --width 8 --height 8 --diff ''", "--diff"},
+      {"convert " + kScenes + "/meshes/quad.obj -o ''", "--output"},
+      {"golden check --root " + std::string(RAYAUDIT_SOURCE_DIR) + " --diff-dir '' doc002-tetrahedron", "--diff-dir"},
+      {"render '' -o " + (dir / "x.png").string(), "scene"},
+  };
+  for (const auto& [args, flag] : cases) {
+    const auto r = run_rayaudit(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(flag + ": empty value"), std::string::npos) << args << "\n" << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+  fs::remove_all(dir);
+}
