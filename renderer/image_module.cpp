@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <mutex>
 #include <string>
+#include <system_error>
 
 #include "errors.h"
 
@@ -38,7 +39,20 @@ const Api* load() {
     std::error_code ec;
     tried += (tried.empty() ? "" : ", ") + (by_name ? "the library path" : path);
     if (!by_name && !fs::exists(path, ec)) continue;
-    void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    void* handle = nullptr;
+    try {
+      // Through a pointer of a type that may throw: glibc declares dlopen
+      // noexcept, and the handler would be compiled away.
+      void* (*volatile open_fn)(const char*, int) = ::dlopen;
+      handle = open_fn(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    } catch (const std::system_error& e) {
+      // OpenImageIO's dependencies start threads in their initialisers: under
+      // a low `ulimit -v` that throws out of dlopen ("rayaudit: error:
+      // Resource temporarily unavailable", naming nothing).
+      throw InputError(located(by_name ? std::string(kFileName) : path, 0,
+                               std::string("cannot load the image module: ") + e.what() +
+                                   " (a library's thread could not start: is the address-space limit `ulimit -v` too low?)"));
+    }
     if (!handle) {
       // A file that is there but does not load (a missing OpenImageIO
       // library, a wrong architecture) is the answer, not the next place.

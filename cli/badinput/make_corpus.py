@@ -266,3 +266,16 @@ GS = '{\n  "goldens": [\n    {\n      ' + GE + '"name": "a", "scene": "scenes/a.
 put('golden', 'spp_2.json', GS % '2')
 put('golden', 'spp_huge.json', GS % '1000000')
 put('golden', 'triangle_method_unknown.json', GS.replace('"moller"', '"mollerr"') % '1')
+# Textures OIIO's readers accepted silently, and files that are no image:
+# refused in our words (via a scene, map_Kd and bump).
+put('texture', 'png_without_iend.png', good[:good.rindex(b'IEND') - 4])
+put('texture', 'ppm_maxval_0.ppm', b'P6\n2 2\n0\n' + b'\x00' * 12)
+put('texture', 'p3_maxval_0.ppm', 'P3\n# a comment\n2 2\n0\n0 0 0 0 0 0 0 0 0 0 0 0\n')
+put('texture', 'obj_as_texture.png', TRI + 'f 1 2 3\n')
+put('texture', 'random_bytes.bin', bytes((i * 7919 + 13) % 251 for i in range(2000)))
+put('mtl', 'map_kd_names_itself.mtl', 'newmtl a\nmap_Kd map_kd_names_itself.mtl\n')
+put('mtl', 'bump_names_an_obj.mtl', 'newmtl a\nbump ../obj/v_word.obj\n')
+put('mtl', 'map_bump_empty_file.mtl', 'newmtl a\nmap_bump ../texture/zero_bytes.png\n')
+put('mtl', 'map_kd_png_without_iend.mtl', 'newmtl a\nKd 1 1 1\nmap_Kd ../texture/png_without_iend.png\n')
+put('mtl', 'bump_ppm_maxval_0.mtl', 'newmtl a\nbump -bm 2 ../texture/ppm_maxval_0.ppm\n')
+put('golden', 'deep_nesting.json', '{"goldens": ' + '[' * 100000 + '\n')

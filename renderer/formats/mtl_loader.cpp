@@ -86,7 +86,8 @@ struct MtlParser {
     return ec == std::errc() && at_separator(q, se);
   }
 
-  void map(std::string& dst, const char* p, const char* se, long line, bool bump) {
+  void map(std::string& dst, const char* p, const char* se, long line, bool bump, std::string* at = nullptr,
+           std::string_view keyword = {}) {
     MtlMaterial& m = out.back();
     for (;;) {
       p = skip_ws(p, se);
@@ -128,6 +129,7 @@ struct MtlParser {
     std::filesystem::path path(file);
     if (path.is_relative()) path = (base / path).lexically_normal();
     dst = path.string();
+    if (at) *at = located(name, line, std::string(keyword) + " '" + file + "'");
     // Missing: a warning (the material renders without it). Anything else
     // that is not a file (a directory, a FIFO, a symlink loop) is an error
     // here, naming this line, not later as a bare path or a library text.
@@ -181,10 +183,10 @@ struct MtlParser {
       return;
     }
     if (kw(k, p, "map_Ka")) return map(m.map_Ka, p, se, line, false);
-    if (kw(k, p, "map_Kd")) return map(m.map_Kd, p, se, line, false);
+    if (kw(k, p, "map_Kd")) return map(m.map_Kd, p, se, line, false, &m.map_Kd_at, {k, size_t(p - k)});
     if (kw(k, p, "map_Ks")) return map(m.map_Ks, p, se, line, false);
     if (kw(k, p, "map_d")) return map(m.map_d, p, se, line, false);
-    if (kw(k, p, "map_bump") || kw(k, p, "bump")) return map(m.map_bump, p, se, line, true);
+    if (kw(k, p, "map_bump") || kw(k, p, "bump")) return map(m.map_bump, p, se, line, true, &m.map_bump_at, {k, size_t(p - k)});
     const std::string key(k, p);
     if (std::find(unknown.begin(), unknown.end(), key) == unknown.end()) {
       unknown.push_back(key);

@@ -73,13 +73,13 @@ class Sax {
   bool start_object(std::size_t n) {
     value();
     keys_.emplace_back();
-    path_.push_back({false, -1, path_.empty() ? "" : pointer_now()});
+    if (lines_) path_.push_back(frame(false));
     return dom_.start_object(n);
   }
   bool key(std::string& k) {
     if (!keys_.back().insert(k).second)
       throw InputError(located(file_, line_at(text_, read_), "key \"" + k + "\" given twice in one object"));
-    if (lines_) {  // a member's line is its key's
+    if (lines_ && path_.back().tracked) {  // a member's line is its key's
       path_.back().key = pointer_token(k);
       (*lines_)[path_.back().prefix + "/" + path_.back().key] = line_at(text_, read_ ? read_ - 1 : 0);
     }
@@ -87,16 +87,18 @@ class Sax {
   }
   bool end_object() {
     keys_.pop_back();
-    path_.pop_back();
+    if (lines_) path_.pop_back();
     return dom_.end_object();
   }
   bool start_array(std::size_t n) {
     value();
-    path_.push_back({true, -1, path_.empty() ? "" : pointer_now()});
+    // Only when lines are asked for: the pointers of a document nested a
+    // million deep would take gigabytes (corpus scene/deep_nesting.json).
+    if (lines_) path_.push_back(frame(true));
     return dom_.start_array(n);
   }
   bool end_array() {
-    path_.pop_back();
+    if (lines_) path_.pop_back();
     return dom_.end_array();
   }
   bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& e) {
@@ -119,14 +121,23 @@ class Sax {
     long index;       // arrays: the current element
     std::string prefix;  // the container's own pointer
     std::string key;  // objects: the current member's token
+    bool tracked = true;  // false below kMaxLineDepth: no lines recorded
   };
+  // Lines are recorded 64 containers deep at most (deeper values take their
+  // ancestor's line): pointers of a document nested 100000 deep would
+  // otherwise take quadratic time and memory.
+  static constexpr std::size_t kMaxLineDepth = 64;
+  Frame frame(bool array) const {
+    if (path_.size() >= kMaxLineDepth) return {array, -1, "", "", false};
+    return {array, -1, path_.empty() ? "" : pointer_now(), "", true};
+  }
   std::string pointer_now() const {
     const Frame& f = path_.back();
     return f.prefix + "/" + (f.array ? std::to_string(f.index) : f.key);
   }
   // A value starts: an array element's line is where it starts.
   void value() {
-    if (!lines_ || path_.empty() || !path_.back().array) return;
+    if (!lines_ || path_.empty() || !path_.back().array || !path_.back().tracked) return;
     ++path_.back().index;
     (*lines_)[pointer_now()] = line_at(text_, read_ ? read_ - 1 : 0);
   }

@@ -84,16 +84,22 @@ void* open(const char* path, Header* header, std::string* err) try {
     return nullptr;
   }
   const OIIO::ImageSpec& spec = in->spec();
-  *header = Header{spec.width, spec.height, spec.nchannels};
+  const int type = spec.format == OIIO::TypeDesc::UINT8    ? ra::image_module::kUint8
+                   : spec.format == OIIO::TypeDesc::UINT16 ? ra::image_module::kUint16
+                                                           : ra::image_module::kFloat;
+  *header = Header{spec.width, spec.height, spec.nchannels, type};
   return in.release();
 } catch (const std::exception& e) {
   *err = exception_text(e);
   return nullptr;
 }
 
-bool read(void* image, int channels, float* dst, std::string* err) try {
+bool read(void* image, int channels, int type, void* dst, std::string* err) try {
   auto* in = static_cast<OIIO::ImageInput*>(image);
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, dst)) {
+  const OIIO::TypeDesc td = type == ra::image_module::kUint8    ? OIIO::TypeDesc::UINT8
+                            : type == ra::image_module::kUint16 ? OIIO::TypeDesc::UINT16
+                                                                : OIIO::TypeDesc::FLOAT;
+  if (!in->read_image(0, 0, 0, channels, td, dst)) {
     *err = first_line(in->geterror());
     return false;
   }
