@@ -522,3 +522,41 @@ TEST(ReliabilityCli, EmptyOptionValuesAreRefusedByName) {
   EXPECT_TRUE(fs::is_empty(dir));
   fs::remove_all(dir);
 }
+
+// Issue 15's fourth pass: `golden check --diff-dir ROOT/golden` replaced the
+// golden it compared against with this render (the next check passed);
+// --json naming a diff image lost the render; `golden bless A BAD` rewrote
+// A's image and failed on BAD, leaving the manifest stale.
+TEST(ReliabilityCli, GoldenOutputsNeverReplaceInputsAndBlessIsAllOrNothing) {
+  const fs::path root = scratch("golden-io");
+  fs::remove_all(root);
+  fs::create_directories(root / "scenes");
+  fs::create_directories(root / "out");
+  std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}}]})"
+                                             << "\n";
+  ASSERT_EQ(run_rayaudit("golden bless t --root " + root.string()).code, 0);
+  // A golden that differs from the render: a check fails and writes its images.
+  std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 0.5}}]})"
+                                             << "\n";
+  const std::string golden = slurp(root / "golden" / "t.png"), manifest = slurp(root / "golden" / "manifest.json");
+  auto r = run_rayaudit("golden check t --root " + root.string() + " --diff-dir " + (root / "golden").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("t.png: is also an input of this command"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(root / "golden" / "t.png"), golden);
+  EXPECT_FALSE(fs::exists(root / "golden" / "t.diff.png"));
+
+  r = run_rayaudit("golden check t --root " + root.string() + " --diff-dir " + (root / "out").string() + " --json " +
+                   (root / "out" / "t.png").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_NE(r.err.find("is named as two outputs of this command"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(root / "out"));
+
+  std::ofstream(root / "scenes" / "zbad.json") << R"({"objects": [{"mesh": "meshes/nosuch.obj"}]})" << "\n";
+  r = run_rayaudit("golden bless t zbad --root " + root.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_NE(r.err.find("zbad.json: /objects/0/mesh: file not found"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(root / "golden" / "t.png"), golden) << "rewritten although the bless failed";
+  EXPECT_EQ(slurp(root / "golden" / "manifest.json"), manifest);
+  fs::remove_all(root);
+}

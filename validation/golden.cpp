@@ -284,6 +284,12 @@ GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
   }
 }
 
+std::vector<std::filesystem::path> GoldenSet::inputs_of(const std::string& name) const {
+  std::vector<fs::path> out{root_ / "scenes" / (name + ".json")};
+  if (auto it = entries_.find(name); it != entries_.end()) out.push_back(root_ / it->second.image);
+  return out;
+}
+
 std::vector<std::string> GoldenSet::all_names() const {
   std::set<std::string> names;
   if (fs::is_directory(root_ / "scenes"))
@@ -353,13 +359,12 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
   return {false, msg};
 }
 
-std::string GoldenSet::bless(const std::string& name) {
+std::string GoldenSet::bless(const std::string& name, OutputBatch* batch) {
   const fs::path scene_file = root_ / "scenes" / (name + ".json");
   if (!fs::exists(scene_file)) {
     auto it = entries_.find(name);
     if (it == entries_.end()) throw InputError(scene_file.string() + ": no such scene");
-    std::error_code ec;
-    fs::remove(root_ / it->second.image, ec);
+    to_remove_.push_back(root_ / it->second.image);  // when the manifest is saved
     entries_.erase(it);
     removed_ = true;
     return name + ": removed (its scene is gone)";
@@ -405,12 +410,15 @@ std::string GoldenSet::bless(const std::string& name) {
   }
   std::error_code ec;
   fs::create_directories((root_ / g.image).parent_path(), ec);
-  if (write_png) write_image(root_ / g.image, img, {8, false});
+  if (write_png) {
+    if (batch) batch->add_replacement(root_ / g.image);
+    write_image(root_ / g.image, img, {8, false});
+  }
   entries_[name] = g;
   return what;
 }
 
-void GoldenSet::save() const {
+void GoldenSet::save(OutputBatch* batch) const {
   json all = json::array();
   for (const auto& [n, e] : entries_) all.push_back(to_json(e));
   json j = {{"about", "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
@@ -418,7 +426,10 @@ void GoldenSet::save() const {
             {"goldens", all}};
   std::error_code ec;
   fs::create_directories(root_ / "golden", ec);
+  if (batch) batch->add_replacement(root_ / "golden" / "manifest.json");
   write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2) + "\n");
+  if (batch) batch->commit();  // the images and the manifest together
+  for (const auto& f : to_remove_) fs::remove(f, ec);
 }
 
 }  // namespace ra
