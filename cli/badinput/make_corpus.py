@@ -279,3 +279,17 @@ put('mtl', 'map_bump_empty_file.mtl', 'newmtl a\nmap_bump ../texture/zero_bytes.
 put('mtl', 'map_kd_png_without_iend.mtl', 'newmtl a\nKd 1 1 1\nmap_Kd ../texture/png_without_iend.png\n')
 put('mtl', 'bump_ppm_maxval_0.mtl', 'newmtl a\nbump -bm 2 ../texture/ppm_maxval_0.ppm\n')
 put('golden', 'deep_nesting.json', '{"goldens": ' + '[' * 100000 + '\n')
+# Second hostile pass (HOSTILE2 F14-F16): PLY/OFF data the header does not
+# declare, an element twice, a float beyond float, counts beyond three.
+PLY3 = 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1
+put('ply', 'element_twice.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1 + '0 0 0\n1 0 0\n0 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'float_1e39.ply', PLY3 + '1e39 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'trailing_line.ply', PLY3 + '0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n1 2 3\n')
+put('ply', 'bin_trailing_bytes.ply', PLY3.replace('ascii', 'binary_little_endian').encode() + struct.pack('<9f', 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack('<B3i', 3, 0, 1, 2) + b'garbage')
+put('ply', 'bin_uint_index_2p32.ply', PLY3.replace('ascii', 'binary_little_endian').replace('uchar int', 'uchar uint').encode() + struct.pack('<9f', 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack('<B3I', 3, 0, 1, 2**32 - 1))
+put('ply', 'format_after_element.ply', 'ply\nelement vertex 3\nformat ascii 1.0\nend_header\n')
+put('ply', 'two_index_lists.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nproperty list uchar int vertex_index\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 3 0 1 2\n')
+put('off', 'trailing_face.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n')
+put('off', 'vertex_extra_values.off', 'OFF\n3 1 0\n0 0 0 9 9\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'four_counts.off', 'OFF\n3 1 0 7\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'face_word_after_indices.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 xyz\n')
