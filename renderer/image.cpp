@@ -107,6 +107,20 @@ class QuietStderr {
 
 namespace {
 
+// The header's size is trusted only as far as the file can hold it: at
+// most kMaxPixelsPerByte pixels a byte, and never beyond the render limit.
+// bytes 0: unknown (not checked).
+void check_declared_size(const std::string& name, const char* what, std::uint64_t w, std::uint64_t h,
+                         std::uint64_t bytes) {
+  const std::string dims = std::to_string(w) + "x" + std::to_string(h);
+  if (w > kMaxImageSide || h > kMaxImageSide)
+    throw InputError(located(name, 0, what + std::string(" is ") + dims + ", more than the limit of " +
+                                          std::to_string(kMaxImageSide) + " pixels a side"));
+  if (bytes && w * h > bytes * kMaxPixelsPerByte)
+    throw InputError(located(name, 0, what + std::string(" header declares ") + dims + " pixels, more than its " +
+                                          std::to_string(bytes) + " bytes can hold (the file is truncated or corrupt)"));
+}
+
 // An image opened by the module, its header checked against the limits.
 struct OpenedImage {
   std::unique_ptr<void, void (*)(void*)> in{nullptr, [](void*) {}};
@@ -119,10 +133,11 @@ OpenedImage open_checked(const std::filesystem::path& path, const char* what) {
   const std::string name = path.string();
   // What OIIO's readers accept silently (a PNG without IEND, a PNM maxval
   // of 0), or an empty file, said before OIIO is asked.
-  if (const ImageProblem why = image_container_problem(path); !why.what.empty())
-    throw InputError(located(name, why.line, std::string("cannot read ") + what + ": " + why.what));
+  const ImageProblem why = image_container_problem(path);
+  if (!why.what.empty()) throw InputError(located(name, why.line, std::string("cannot read ") + what + ": " + why.what));
   std::error_code ec;
   const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+  if (why.width || why.height) check_declared_size(name, what, why.width, why.height, ec ? 0 : bytes);
   const image_module::Api& oiio = image_module::api();
   OpenedImage o;
   o.name = name;
@@ -135,14 +150,7 @@ OpenedImage open_checked(const std::filesystem::path& path, const char* what) {
   if (w == 0 || h == 0 || spec.channels < 1 || spec.channels > 64)
     throw InputError(located(name, 0, what + std::string(" header declares ") + o.dims + " with " +
                                           std::to_string(spec.channels) + " channels"));
-  // The header's size is trusted only as far as the file can hold it: at
-  // most kMaxPixelsPerByte pixels a byte, and never beyond the render limit.
-  if (w > kMaxImageSide || h > kMaxImageSide)
-    throw InputError(located(name, 0, what + std::string(" is ") + o.dims + ", more than the limit of " +
-                                          std::to_string(kMaxImageSide) + " pixels a side"));
-  if (!ec && w * h > bytes * kMaxPixelsPerByte)
-    throw InputError(located(name, 0, what + std::string(" header declares ") + o.dims + " pixels, more than its " +
-                                          std::to_string(bytes) + " bytes can hold (the file is truncated or corrupt)"));
+  check_declared_size(name, what, w, h, ec ? 0 : bytes);
   return o;
 }
 
@@ -205,6 +213,15 @@ StoredPixels read_stored_pixels(const std::filesystem::path& path, const char* w
     default:
       allocate(p.f, n, o, what);
       read_into(o, p.channels, image_module::kFloat, p.f.data(), what);
+      // A NaN or infinite texel (PFM, EXR) rendered black, silently: every
+      // other reader refuses non-finite numbers.
+      for (std::size_t i = 0; i < p.f.size(); ++i)
+        if (!std::isfinite(p.f[i])) {
+          const std::size_t px = i / std::size_t(p.channels);
+          throw InputError(located(o.name, 0, std::string(what) + " texel (" + std::to_string(px % std::size_t(p.width)) +
+                                                  ", " + std::to_string(px / std::size_t(p.width)) + ") is " +
+                                                  (std::isnan(p.f[i]) ? "NaN" : "infinite") + ", not a colour"));
+        }
   }
   return p;
 }

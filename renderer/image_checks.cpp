@@ -4,6 +4,9 @@
 #include "image_checks.h"
 
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
@@ -33,16 +36,37 @@ std::string png_problem(std::ifstream& in, std::uint64_t size) {
   }
 }
 
-// P1..P6: width, height and (but for P1, P4) maxval, with '#' comments.
-ImageProblem pnm_problem(std::ifstream& in) {
+// P1..P6: width, height and (but for P1, P4) maxval, with '#' comments;
+// in the ASCII kinds (P1..P3) every sample too (999 above a maxval of 255,
+// or -5, were read as given).
+ImageProblem pnm_problem(std::ifstream& in, std::uint64_t size) {
   in.seekg(0);
-  std::string head(512, '\0');
+  const char kind = [&] { char k[2] = {}; in.read(k, 2); return k[1]; }();
+  const bool ascii = kind >= '1' && kind <= '3';
+  in.seekg(0);
+  std::string head(ascii ? std::size_t(size) : 512, '\0');
   in.read(head.data(), std::streamsize(head.size()));
   head.resize(std::size_t(in.gcount()));
-  const char kind = head[1];
   const int fields = kind == '1' || kind == '4' ? 2 : 3;
+  const char* names[3] = {"width", "height", "maxval"};
   std::size_t i = 2;
   long line = 1;
+  std::uint64_t maxval = kind == '1' ? 1 : 0;
+  auto skip = [&] {
+    for (;;) {  // whitespace and comments
+      while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) line += head[i++] == '\n';
+      if (i < head.size() && head[i] == '#') {
+        while (i < head.size() && head[i] != '\n') ++i;
+        continue;
+      }
+      return;
+    }
+  };
+  auto token = [&] {
+    std::size_t e = i;
+    while (e < head.size() && !std::isspace(static_cast<unsigned char>(head[e])) && e - i < 20) ++e;
+    return head.substr(i, e - i);
+  };
   for (int f = 0; f < fields; ++f) {
     for (;;) {  // whitespace and comments
       while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) line += head[i++] == '\n';
@@ -55,10 +79,80 @@ ImageProblem pnm_problem(std::ifstream& in) {
     std::uint64_t v = 0;
     const std::size_t b = i;
     while (i < head.size() && std::isdigit(static_cast<unsigned char>(head[i])) && i - b < 12) v = v * 10 + std::uint64_t(head[i++] - '0');
-    if (i == b) return {};  // not a number: OIIO's reader says what is wrong
+    if (i == b || (i < head.size() && !std::isspace(static_cast<unsigned char>(head[i])))) {
+      i = b;
+      return {line, std::string("PNM header: expected the ") + names[f] + ", found '" + token() + "'"};
+    }
     if (f == 2 && (v < 1 || v > 65535)) return {line, "PNM maxval " + std::to_string(v) + " (must be 1 to 65535)"};
+    if (f == 2) maxval = v;
   }
+  if (!ascii) return {};
+  ++i;  // the one whitespace byte after the header
+  for (;;) {
+    skip();
+    if (i >= head.size()) return {};
+    if (kind == '1') {  // bits need no separator: "0101"
+      if (head[i] != '0' && head[i] != '1') return {line, "PBM bit '" + token() + "' (must be 0 or 1)"};
+      ++i;
+      continue;
+    }
+    const std::size_t b = i;
+    std::uint64_t v = 0;
+    while (i < head.size() && std::isdigit(static_cast<unsigned char>(head[i])) && i - b < 12) v = v * 10 + std::uint64_t(head[i++] - '0');
+    if (i == b || (i < head.size() && !std::isspace(static_cast<unsigned char>(head[i])) && head[i] != '#')) {
+      i = b;
+      return {line, "PNM sample '" + token() + "' is not a number from 0 to the maxval " + std::to_string(maxval)};
+    }
+    if (v > maxval) return {line, "PNM sample " + std::to_string(v) + " above the maxval " + std::to_string(maxval)};
+  }
+}
+
+// PF / Pf (PFM): width, height and a scale whose sign is the byte order; 0
+// (or not a number) is no scale.
+ImageProblem pfm_problem(std::ifstream& in) {
+  in.seekg(0);
+  std::string head(256, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  head.resize(std::size_t(in.gcount()));
+  std::istringstream s(head.substr(2));
+  long w = 0, h = 0;
+  std::string scale;
+  if (!(s >> w >> h >> scale)) return {};
+  char* end = nullptr;
+  const double v = std::strtod(scale.c_str(), &end);
+  if (end != scale.c_str() + scale.size() || !(std::fabs(v) > 0) || !std::isfinite(v))
+    return {3, "PFM scale '" + scale + "' (must be a non-zero number: its sign gives the byte order)"};
   return {};
+}
+
+std::uint16_t le16(const unsigned char* p) { return std::uint16_t(p[0] | p[1] << 8); }
+
+// GIF: the logical screen's size, and the first image's (OIIO's reader
+// decodes the first frame when it opens the file).
+ImageProblem gif_size(std::ifstream& in, std::uint64_t size) {
+  in.seekg(0);
+  std::vector<unsigned char> b(std::size_t(std::min<std::uint64_t>(size, 1 << 16)));
+  in.read(reinterpret_cast<char*>(b.data()), std::streamsize(b.size()));
+  b.resize(std::size_t(in.gcount()));
+  if (b.size() < 13) return {};
+  ImageProblem p;
+  p.width = le16(&b[6]);
+  p.height = le16(&b[8]);
+  std::size_t i = 13 + ((b[10] & 0x80) ? 3u << ((b[10] & 7) + 1) : 0);
+  while (i < b.size()) {
+    if (b[i] == 0x21 && i + 2 < b.size()) {  // an extension: label, sub-blocks up to a 0
+      i += 2;
+      while (i < b.size() && b[i] != 0) i += std::size_t(b[i]) + 1;
+      ++i;
+    } else if (b[i] == 0x2C && i + 9 < b.size()) {  // the first image descriptor
+      p.width = std::max<std::uint64_t>(p.width, le16(&b[i + 5]));
+      p.height = std::max<std::uint64_t>(p.height, le16(&b[i + 7]));
+      break;
+    } else {
+      break;
+    }
+  }
+  return p;
 }
 
 // Text: no NUL and no control bytes but tab, line ends and form feed in the
@@ -91,12 +185,18 @@ ImageProblem image_container_problem(const std::filesystem::path& path) {
   const std::size_t got = std::size_t(in.gcount());
   in.clear();
   if (got == 8 && std::equal(sig, sig + 8, kPngSignature)) return {0, png_problem(in, size)};
-  if (got >= 3 && sig[0] == 'P' && sig[1] >= '1' && sig[1] <= '6' && std::isspace(sig[2])) return pnm_problem(in);
+  if (got >= 3 && sig[0] == 'P' && sig[1] >= '1' && sig[1] <= '6' && std::isspace(sig[2])) return pnm_problem(in, size);
+  if (got >= 3 && sig[0] == 'P' && (sig[1] == 'F' || sig[1] == 'f') && std::isspace(sig[2])) return pfm_problem(in);
+  if (got >= 6 && (std::string(reinterpret_cast<char*>(sig), 6) == "GIF87a" || std::string(reinterpret_cast<char*>(sig), 6) == "GIF89a"))
+    return gif_size(in, size);
   return {};
 }
 
 std::string image_open_problem(const std::filesystem::path& path, const std::string& oiio_err) {
-  if (looks_like_text(head_of(path))) return "not an image (a text file)";
+  const std::string head = head_of(path);
+  if (looks_like_text(head)) return "not an image (a text file)";
+  if (head.rfind("GIF8", 0) == 0 && oiio_err.find("could not find a format reader") != std::string::npos)
+    return "not a readable GIF (no image in it, or a corrupt header)";
   if (oiio_err.find("could not find a format reader") != std::string::npos)
     return "not an image (no image format recognises it)";
   return oiio_err;

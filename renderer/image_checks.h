@@ -3,6 +3,7 @@
 // data (no IEND), a PNM whose maxval is 0, and files that are no image at
 // all (text, a mesh, an empty file), which OIIO describes in its own words.
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -14,6 +15,10 @@ namespace ra {
 struct ImageProblem {
   long line = 0;
   std::string what;
+  // The size the header declares where OIIO's reader would allocate it in
+  // open() already (GIF: a 35-byte file declaring 16384^2 took 1.2 GB), so
+  // the caller can apply its limits first; 0 when not read here.
+  std::uint64_t width = 0, height = 0;
 };
 ImageProblem image_container_problem(const std::filesystem::path& path);
 

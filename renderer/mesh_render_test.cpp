@@ -348,6 +348,24 @@ TEST(Texture, EightAndSixteenBitTexelsAreOiiosFloatsBitForBit) {
     }
 }
 
+// The PNM checks (issue 15: maxval 0, samples above maxval) refuse nothing
+// that is valid: comments anywhere, samples equal to the maxval, packed
+// lines, and a PFM's negative (little-endian) scale.
+TEST(Texture, ValidPnmAndPfmTexturesStillLoad) {
+  const auto dir = temp_dir();
+  std::ofstream(dir / "a.ppm") << "P3\n# made by hand\n2 1 # size\n15\n15 0 7\n# a comment between samples\n0 15 15 # end\n";
+  const Texture a = load_texture(dir / "a.ppm");
+  EXPECT_EQ(a.texel(0, 0).x, 1.0);
+  EXPECT_EQ(a.texel(1, 0).y, 1.0);
+  std::ofstream(dir / "b.pgm") << "P2 2 1 65535 65535 0\n";
+  EXPECT_NEAR(load_texture(dir / "b.pgm").texel(0, 0).x, 1.0, 1e-4);  // OIIO reads 65535 as 65534/65535
+  std::string pfm = "PF\n1 1\n-1.0\n";
+  const float px[3] = {0.25f, 0.5f, 2.0f};
+  pfm.append(reinterpret_cast<const char*>(px), sizeof px);
+  std::ofstream(dir / "c.pfm", std::ios::binary) << pfm;
+  EXPECT_EQ(load_texture(dir / "c.pfm").texel(0, 0).z, 2.0);
+}
+
 // The same texels in a TGA written byte by byte the way most tools write
 // it: uncompressed true-colour (type 2), BGR, origin at the BOTTOM left
 // (descriptor bit 5 clear), so the file holds the bottom row first.

@@ -293,3 +293,14 @@ put('off', 'trailing_face.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1
 put('off', 'vertex_extra_values.off', 'OFF\n3 1 0\n0 0 0 9 9\n1 0 0\n0 1 0\n3 0 1 2\n')
 put('off', 'four_counts.off', 'OFF\n3 1 0 7\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
 put('off', 'face_word_after_indices.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 xyz\n')
+# Second hostile pass (HOSTILE2 F8-F11): sizes OIIO's GIF reader allocated in
+# open(), PNM/PFM values out of range, non-finite texels, a GIF without image.
+put('texture', 'gif_16384_in_35_bytes.gif', b'GIF89a\x00\x40\x00\x40\x80\x00\x00\x00\x00\x00\xff\xff\xff,\x00\x00\x00\x00\x00\x40\x00\x40\x00\x02\x02\x44\x01\x00;')
+put('texture', 'gif_without_image.gif', b'GIF89a\x04\x00\x04\x00\x00\x00\x00;')
+put('texture', 'ppm_maxval_65536.ppm', b'P6\n2 2\n65536\n' + b'\x00' * 24)
+put('texture', 'ppm_maxval_negative.ppm', b'P6\n2 2\n-1\n' + b'\x00' * 24)
+put('texture', 'p3_sample_above_maxval.ppm', 'P3\n2 2\n255\n0 0 0\n999 0 0 0 0 0 0 0 0\n')
+put('texture', 'p2_negative_sample.pgm', 'P2\n2 2\n15\n-5 0 0 0\n')
+put('texture', 'pbm_bit_2.pbm', 'P1\n2 2\n0 2 0 1\n')
+put('texture', 'pfm_scale_0.pfm', b'PF\n2 2\n0\n' + struct.pack('<f', 1.0) * 12)
+put('texture', 'pfm_nan_texel.pfm', b'PF\n2 2\n-1.0\n' + struct.pack('<f', 0.5) * 3 + struct.pack('<f', float('nan')) * 9)
