@@ -39,6 +39,7 @@ constexpr long long kMaxExportRays = 10000000;
 
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
+  bool precision_given = false;  // --precision on the command line (not its default)
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
@@ -233,11 +234,22 @@ void audit_cases(const Args& a) {
   outputs.commit();
 }
 
+// --grade and --export-cases work in one precision: `--precision
+// float,double` given by hand was dropped to double silently (the default,
+// both, still means double).
+std::vector<Precision> one_precision(const Args& a, const char* what) {
+  const auto ps = chosen_precisions(a.precision);
+  if (a.precision_given && ps.size() > 1)
+    throw ra::InputError(std::string("--precision: ") + what + " takes one precision (float or double), got '" +
+                         a.precision + "'");
+  return ps;
+}
+
 // ----------------------------------------------------------- --grade ---
 void grade(const Args& a) {
   if (!a.methods.empty()) throw ra::InputError("audit: --grade grades the answers file, not --methods: drop --methods");
   ra::OutputBatch outputs({a.json, a.csv});
-  const auto ps = chosen_precisions(a.precision);
+  const auto ps = one_precision(a, "--grade");
   // Answers are double unless only float was asked for (as --export-cases).
   const Precision p = ps.size() == 1 ? ps[0] : Precision::f64;
   const std::string method = std::filesystem::path(a.grade).stem().string();
@@ -262,7 +274,7 @@ void export_cases(const Args& a) {
     throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
                          std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
   ra::declare_output(a.export_cases);
-  const auto precisions = chosen_precisions(a.precision);
+  const auto precisions = one_precision(a, "--export-cases");
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
   const auto rows = export_rows(chosen_families(a.families), p, a.seed, a.rays);
@@ -406,7 +418,7 @@ void setup(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)")
       ->check(ra::cli::non_empty_list());
-  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
+  auto* precision = cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
   cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names())
       ->check(ra::cli::non_empty_list());
   cmd->add_option("--rays", a->rays,
@@ -462,8 +474,9 @@ void setup(CLI::App& app) {
   merge_cmd->add_option("--json", a->json, "Write the merged JSON here")->required();
   merge_cmd->add_option("--csv", a->csv, "Write the merged per-cell CSV here");
   merge_cmd->callback([a] { merge(*a); });
-  cmd->callback([a, merge_cmd] {
+  cmd->callback([a, merge_cmd, precision] {
     if (merge_cmd->parsed()) return;
+    a->precision_given = precision->count() > 0;
     if (!a->grade.empty()) return grade(*a);
     if (!a->cases.empty()) return audit_cases(*a);
     if (!a->export_cases.empty()) return export_cases(*a);

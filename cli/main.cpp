@@ -34,6 +34,11 @@ void refuse_empty_values(CLI::App& app) {
 
 int main(int argc, char** argv) {
   // Answered before any command is set up, with its newline.
+  // `--version extra` printed the version and exited 0, the extra ignored.
+  if (argc > 2 && std::string_view(argv[1]) == "--version") {
+    std::cerr << "rayaudit: --version takes no arguments, got '" << argv[2] << "' (see --help)\n";
+    return 2;
+  }
   if (argc == 2 && std::string_view(argv[1]) == "--version") {
     std::cout << "rayaudit " << RAYAUDIT_VERSION << "\n";
     return 0;

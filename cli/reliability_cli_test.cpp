@@ -560,3 +560,20 @@ TEST(ReliabilityCli, GoldenOutputsNeverReplaceInputsAndBlessIsAllOrNothing) {
   EXPECT_EQ(slurp(root / "golden" / "manifest.json"), manifest);
   fs::remove_all(root);
 }
+
+// HOSTILE2 F1, F2: a second precision for --export-cases was dropped
+// silently (a file of double cases, exit 0); `--version extra` exited 0.
+TEST(ReliabilityCli, ExportCasesWithTwoPrecisionsAndVersionWithAnArgumentAreRefused) {
+  const fs::path out = scratch("two-precisions.csv");
+  auto r = run_rayaudit("audit --export-cases " + out.string() + " --precision float,double --rays 10");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, "--precision: --export-cases takes one precision (float or double), got 'float,double'\n");
+  EXPECT_FALSE(fs::exists(out));
+  r = run_rayaudit("audit --export-cases " + out.string() + " --precision float --rays 10");
+  EXPECT_EQ(r.code, 0) << r.all;
+  r = run_rayaudit("--version extra");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  fs::remove(out);
+}
