@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <unordered_set>
 
 #include "mesh.h"
 #include "../io/file_identity.h"
@@ -49,10 +50,18 @@ struct MtlParser {
   Where w{&name};
   std::vector<MtlMaterial> out;
   std::vector<bool> has_d;
-  std::vector<std::string> unknown;
+  std::unordered_set<std::string> unknown;  // a set: distinct unknown statements were a quadratic scan
+  CappedWarnings missing{warnings, name, "more textures not found"};
+  CappedWarnings early{warnings, name, "more statements before the first newmtl ignored"};
+  CappedWarnings unsupported{warnings, name, "more unsupported MTL statements ignored"};
 
   MtlParser(const std::string& n, const std::filesystem::path& b, bool check, std::vector<std::string>& warn)
       : name(n), base(b), check_files(check), warnings(warn) {}
+  void finish() {
+    missing.finish();
+    early.finish();
+    unsupported.finish();
+  }
 
   bool kw(const char* k, const char* kend, const char* word) { return is_kw(k, kend, upper(word).c_str()); }
 
@@ -136,7 +145,7 @@ struct MtlParser {
     if (!check_files) return;
     const std::string why = input_file_problem(path);
     if (why == "no such file")
-      warnings.push_back(located(name, line, "texture '" + file + "' not found (" + dst + ")"));
+      missing.add(line, located(name, line, "texture '" + file + "' not found (" + dst + ")"));
     else if (!why.empty())
       w.fail(line, "texture '" + file + "': " + why + " (" + dst + ")");
     else
@@ -157,7 +166,7 @@ struct MtlParser {
       return;
     }
     if (out.empty()) {
-      warnings.push_back(located(name, line, "statement before the first newmtl ignored"));
+      early.add(line, located(name, line, "statement before the first newmtl ignored"));
       return;
     }
     MtlMaterial& m = out.back();
@@ -188,10 +197,7 @@ struct MtlParser {
     if (kw(k, p, "map_d")) return map(m.map_d, p, se, line, false);
     if (kw(k, p, "map_bump") || kw(k, p, "bump")) return map(m.map_bump, p, se, line, true, &m.map_bump_at, {k, size_t(p - k)});
     const std::string key(k, p);
-    if (std::find(unknown.begin(), unknown.end(), key) == unknown.end()) {
-      unknown.push_back(key);
-      warnings.push_back(located(name, line, "unsupported MTL statement '" + key + "' ignored"));
-    }
+    if (unknown.insert(key).second) unsupported.add(line, located(name, line, "unsupported MTL statement '" + key + "' ignored"));
   }
 };
 
@@ -212,6 +218,7 @@ std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& nam
     line += extra + 1;
     p = se + 1;
   }
+  parser.finish();
   return std::move(parser.out);
 }
 

@@ -42,6 +42,7 @@
 #include <string>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -987,8 +988,9 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
   namespace fs = std::filesystem;
   if (opt.load_materials) {
     const fs::path dir = fs::path(m.path).parent_path();
-    std::vector<std::string> loaded;
+    std::unordered_set<std::string> loaded;  // a set: 50,000 mtllib lines were a quadratic scan
     std::unordered_map<std::string, int> defined;
+    objtext::CappedWarnings missing{m.warnings, m.path, "more material libraries not found or not files"};
     for (auto& [line, raw] : mtllibs) {
       std::vector<std::string> files;
       std::error_code ec;
@@ -1009,10 +1011,9 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
       for (auto& f : files) {
         const fs::path file = dir / slashes(f);
         const std::string key = file.lexically_normal().string();
-        if (std::find(loaded.begin(), loaded.end(), key) != loaded.end()) continue;
-        loaded.push_back(key);
+        if (!loaded.insert(key).second) continue;
         if (const std::string why = input_file_problem(file); !why.empty()) {
-          m.warnings.push_back(located(m.path, line,
+          missing.add(line, located(m.path, line,
                                        "material library '" + f + "' " +
                                            (why == "no such file" ? std::string("not found") : why) +
                                            " (its materials get defaults)"));
@@ -1028,7 +1029,9 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
         }
       }
     }
+    missing.finish();
   }
+  objtext::CappedWarnings undefined{m.warnings, m.path, "more materials not defined (default material used)"};
   std::unordered_map<std::string, int> byname;
   for (size_t i = 0; i < m.materials.size(); ++i) byname.emplace(m.materials[i].name, int(i));
   std::vector<int> map(used.names.size());
@@ -1039,8 +1042,8 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
       map[i] = it->second;
     } else {
       if (opt.load_materials)
-        m.warnings.push_back(located(m.path, used.lines[i],
-                                     "material '" + used.names[i] + "' is not defined (default material used)"));
+        undefined.add(used.lines[i], located(m.path, used.lines[i],
+                                             "material '" + used.names[i] + "' is not defined (default material used)"));
       MtlMaterial d;
       d.name = used.names[i];
       map[i] = int(m.materials.size());
@@ -1049,6 +1052,7 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
     }
     identity = identity && map[i] == int(i);
   }
+  undefined.finish();
   if (!identity)
     for (auto& t : m.triangles)
       if (t.material >= 0) t.material = map[size_t(t.material)];
