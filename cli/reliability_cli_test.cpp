@@ -577,3 +577,22 @@ TEST(ReliabilityCli, ExportCasesWithTwoPrecisionsAndVersionWithAnArgumentAreRefu
   EXPECT_TRUE(r.out.empty());
   fs::remove(out);
 }
+
+// HOSTILE2 F22: an OBJ read through its memory map was not noted as an
+// input, so `crack-maps --mesh` naming one of its own maps overwrote it.
+TEST(ReliabilityCli, CrackMapsMeshThatIsOneOfItsMapsIsRefused) {
+  const fs::path dir = scratch("cm-mesh-input");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path mesh = dir / "sphere-moller-1.png";
+  fs::copy_file(kScenes + "/meshes/tetrahedron.obj", mesh);
+  const std::string before = slurp(mesh);
+  const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + mesh.string() +
+                              " --methods moller --offsets 1 --size 8");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("sphere-moller-1.png: is also an input of this command"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(mesh), before);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+  fs::remove_all(dir);
+}

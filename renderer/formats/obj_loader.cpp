@@ -1283,6 +1283,9 @@ namespace {
 class FileBytes {
  public:
   FileBytes(const std::filesystem::path& file, std::uint64_t max_bytes) {
+    // Noted as an input on the mapped path too: crack-maps --mesh naming one
+    // of its own maps was overwritten (HOSTILE2 F22).
+    check_input_file(file);
     std::error_code ec;
     const auto size = std::filesystem::file_size(file, ec);
 #if defined(__unix__)
