@@ -14,6 +14,7 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "io/input_file.h"
 #include "memory_budget.h"
 #include "golden.h"
 #include "image_compare.h"
@@ -161,8 +162,11 @@ void run(const Args& a) {
   }
   // The default tolerance file may be absent (identical at 8 bits); one named
   // on the command line must exist.
-  if (!a.tolerance.empty() && !std::filesystem::is_regular_file(a.tolerance))
-    throw ra::InputError(a.tolerance + ": no such tolerance file");
+  if (!a.tolerance.empty()) {  // a FIFO or directory was "no such tolerance file"
+    const std::string why = ra::input_file_problem(a.tolerance);
+    if (!why.empty())
+      throw ra::InputError(ra::located(a.tolerance, 0, why == "no such file" ? "no such tolerance file" : why));
+  }
   const ra::PovTolerance tol =
       ra::load_pov_tolerance(a.tolerance.empty() ? ra::pov_tolerance_path(a.scene) : std::filesystem::path(a.tolerance));
 

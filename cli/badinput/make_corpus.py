@@ -304,3 +304,6 @@ put('texture', 'p2_negative_sample.pgm', 'P2\n2 2\n15\n-5 0 0 0\n')
 put('texture', 'pbm_bit_2.pbm', 'P1\n2 2\n0 2 0 1\n')
 put('texture', 'pfm_scale_0.pfm', b'PF\n2 2\n0\n' + struct.pack('<f', 1.0) * 12)
 put('texture', 'pfm_nan_texel.pfm', b'PF\n2 2\n-1.0\n' + struct.pack('<f', 0.5) * 3 + struct.pack('<f', float('nan')) * 9)
+# HOSTILE2 F21, F23: the file's own number quoted; a directory named as such.
+put('tolerance', 'pixel_x_2p63.json', '{"width": 8, "height": 8, "pixels": [{"x": 9223372036854775808, "y": 1, "levels": 1, "cause": "c"}]}\n')
+put_dir('tolerance', 'is_a_directory.json')
