@@ -596,3 +596,38 @@ TEST(ReliabilityCli, CrackMapsMeshThatIsOneOfItsMapsIsRefused) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
   fs::remove_all(dir);
 }
+
+// HOSTILE2 F25: report's own checks let through what report.py then failed
+// on with a traceback: a subject without /PRECISION, negative counts, hex
+// seconds. Each is now one line before Python runs.
+TEST(ReliabilityCli, ReportRefusesWhatItsScriptCannotTakeInOneLine) {
+  const fs::path dir = scratch("report-f25");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path audit = dir / "a.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
+  std::string text = slurp(audit);
+  auto edited = [&](const std::string& from, const std::string& to, const std::string& name) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+    std::ofstream(dir / name) << t;
+    return (dir / name).string();
+  };
+  const std::string subject = edited("\"subject\": \"moller/float\"", "\"subject\": \"moller\"", "b.json");
+  const std::string negative = edited("\"tests\": ", "\"tests\": -5, \"was\": ", "d.json");
+  std::ofstream(dir / "st.tsv") << "a\t0x10\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--audit " + subject, "b.json: cells[0]: subject 'moller' is not one of the subjects"},
+      {"--audit " + negative, "d.json: cells[0].stats.tests: -5 is negative"},
+      {"--audit " + audit.string() + " --stages " + (dir / "st.tsv").string(), "st.tsv:1: expected STAGE<TAB>SECONDS"}};
+  for (const auto& [args, want] : cases) {
+    const auto r = run_rayaudit("report " + args + " -o " + (dir / "rep").string());
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find(want), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "rep"));
+  }
+  fs::remove_all(dir);
+}
