@@ -324,6 +324,13 @@ TEST(AuditShards, HostileShardsAreOneLineErrors) {
   const fs::path small = tmp("hsmall.json");
   write(small, ja.dump());
   one_error(small, big, big.string() + ": a count overflows 2^64-1 when merged");
+  // HOSTILE2 F26: a 191 MB shard ended in std::bad_alloc; sizes are checked
+  // before parsing (a sparse file: nothing is read).
+  const fs::path huge_file = tmp("hhuge.json");
+  std::ofstream(huge_file) << "{";
+  fs::resize_file(huge_file, std::uint64_t(65) << 20);
+  one_error(huge_file, b, huge_file.string() + ": 68157440 bytes, more than the 64 MB limit for a shard");
+  fs::remove(huge_file);
   auto huge = [&](const fs::path& from, const fs::path& to) {
     auto j = nlohmann::json::parse(slurp(from));
     j["shard"]["n"] = 4000000000ULL;

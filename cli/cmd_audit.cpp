@@ -22,6 +22,7 @@
 #include "io/file_identity.h"
 #include "grade.h"
 #include "io/input_file.h"
+#include <new>
 #include "io/json_input.h"
 #include "registry.h"
 
@@ -334,10 +335,27 @@ struct ShardFile {
   Report report;
 };
 
+// A shard of every method of the registry on every family is about 3 MB;
+// its parsed form takes ~30 times its size, so a 191 MB file ended in a bare
+// std::bad_alloc (HOSTILE2 F26). Larger files are refused from their size.
+constexpr std::uint64_t kMaxShardBytes = std::uint64_t(64) << 20;
+
 ShardFile read_shard(const std::string& path) {
+  ra::check_input_file(path);
+  std::error_code ec;
+  const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kMaxShardBytes)
+    throw ra::InputError(ra::located(path, 0, std::to_string(bytes) + " bytes, more than the " +
+                                                  std::to_string(kMaxShardBytes >> 20) +
+                                                  " MB limit for a shard (one of every method on every family is a few MB)"));
   // read_json_file: a directory or FIFO named, not read or waited on; a
   // syntax error at its line; a key given twice refused.
-  ShardFile f{path, ra::read_json_file(path), {}};
+  ShardFile f{path, {}, {}};
+  try {
+    f.json = ra::read_json_file(path);
+  } catch (const std::bad_alloc&) {
+    throw ra::InputError(ra::located(path, 0, "not enough memory to read this shard"));
+  }
   if (!f.json.is_object() || !f.json.contains("shard"))
     throw ra::InputError(ra::located(path, 0, "not a shard's output (no \"shard\" key: run audit with --shard K/N)"));
   try {
