@@ -6,11 +6,15 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <algorithm>
+#include <cstdint>
 #include <mutex>
+#include <thread>
 #include <string>
 #include <system_error>
 
 #include "errors.h"
+#include "memory_budget.h"
 
 namespace ra::image_module {
 namespace {
@@ -30,6 +34,23 @@ std::vector<std::string> candidates() {
   out.push_back(kFileName);  // no slash: dlopen searches the executable's RUNPATH
   out.push_back((fs::path(RAYAUDIT_INSTALL_FULL_LIBDIR) / "rayaudit" / kFileName).string());
   return out;
+}
+
+// OpenImageIO and its ~260 libraries map about 430 MB of address space as
+// they load (2 cores), and some start threads in their initialisers. Under
+// an address-space limit (`ulimit -v`, prlimit --as) that leaves less, the
+// load or the first read aborted, segfaulted or hung inside those libraries
+// (410-450 MB: HOSTILE2 F28), or blamed a valid texture. Refused here,
+// before dlopen, with one line: 480 MB and a thread stack (8 MB) a core.
+void check_address_space() {
+  const std::uint64_t need = (std::uint64_t(480) << 20) +
+                             (std::uint64_t(8) << 20) * std::max(1u, std::thread::hardware_concurrency());
+  const std::uint64_t left = available_memory();
+  if (left < need)
+    throw InputError(located(kFileName, 0,
+                             "the image module (OpenImageIO) needs about " + std::to_string(need >> 20) +
+                                 " MB of address space to load, but only " + std::to_string(left >> 20) +
+                                 " MB are left (the address-space limit `ulimit -v`, or free memory): raise it"));
 }
 
 const Api* load() {
@@ -80,7 +101,10 @@ const Api& api() {
   static std::mutex m;
   static const Api* loaded = nullptr;
   std::lock_guard<std::mutex> lock(m);
-  if (!loaded) loaded = load();
+  if (!loaded) {
+    check_address_space();
+    loaded = load();
+  }
   return *loaded;
 }
 

@@ -73,7 +73,7 @@ bool write_exr(const char* path, int w, int h, const float* rgb, std::string* er
 // library ("vector::_M_default_append" for a 65535x65535 GIF): said as such.
 std::string exception_text(const std::exception& e) {
   if (dynamic_cast<const std::length_error*>(&e) || dynamic_cast<const std::bad_alloc*>(&e))
-    return "the size the file declares cannot be allocated (corrupt header?)";
+    return "the size the file declares cannot be allocated (a corrupt header, or too little memory: `ulimit -v`?)";
   return e.what();
 }
 
