@@ -45,12 +45,12 @@ std::vector<std::string> candidates() {
 void check_address_space() {
   const std::uint64_t need = (std::uint64_t(480) << 20) +
                              (std::uint64_t(8) << 20) * std::max(1u, std::thread::hardware_concurrency());
-  const std::uint64_t left = available_memory();
+  const std::uint64_t left = address_space_left();
   if (left < need)
     throw InputError(located(kFileName, 0,
                              "the image module (OpenImageIO) needs about " + std::to_string(need >> 20) +
                                  " MB of address space to load, but only " + std::to_string(left >> 20) +
-                                 " MB are left (the address-space limit `ulimit -v`, or free memory): raise it"));
+                                 " MB are left under the address-space limit (`ulimit -v`): raise it"));
 }
 
 const Api* load() {
