@@ -250,7 +250,6 @@ put('off', 'counts_without_edges.off', 'OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n
 put('off', 'cr_only_line_ends.off', 'OFF\r3 1 0\r0 0 0\r1 0 0\r0 1 0\r3 0 1 x\r')
 put('ply', 'face_without_vertex_indices.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int idx\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
 put('ply', 'cr_only_line_ends.ply', 'ply\rformat ascii 1.0\relement vertex 3\rproperty float x\rproperty float y\rproperty float z\rend_header\r0 0 0\r1 0 0\r0 q 0\r')
-put('mtl', 'newmtl_without_name.mtl', 'newmtl a\nKd 1 0 0\nnewmtl\nKd 0 1 0\n')
 # `l` and `p` are not rendered, but their indices are checked like a face's.
 put('obj', 'l_index_past_end.obj', TRI + 'f 1 2 3\nl 1 2 9\n')
 put('obj', 'l_index_zero.obj', TRI + 'l 0 1\nf 1 2 3\n')

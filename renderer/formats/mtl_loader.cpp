@@ -11,9 +11,10 @@
 //   (`-s 2 2 1 -bm 0.5 my tex.png` is "my tex.png" with bump_multiplier 0.5).
 //   Backslashes become '/', relative names are resolved against the .mtl's
 //   directory, a missing file is a warning.
-// - Statements before the first newmtl and unknown ones are warnings.
-//   `newmtl` without a name is an error at its line (it was two warnings
-//   and a material no `usemtl` can name on purpose).
+// - Statements before the first newmtl, unknown ones and `newmtl` without
+//   a name are warnings. The last stays accepted, as the material named "":
+//   Blender writes `newmtl ` with `usemtl ` (the assimp test model
+//   empty_mat.obj), so refusing it would refuse real exporter output.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -159,7 +160,7 @@ struct MtlParser {
     while (!at_separator(p, se)) ++p;
     if (kw(k, p, "newmtl")) {
       std::string n(rest_as_name(p, se));
-      if (n.empty()) w.fail(line, "newmtl without a material name");
+      if (n.empty()) warnings.push_back(located(name, line, "newmtl without a name (material named '')"));
       out.emplace_back();
       out.back().name = std::move(n);
       has_d.push_back(false);
