@@ -51,7 +51,8 @@ ImageProblem pnm_problem(std::ifstream& in, std::uint64_t size) {
   const char* names[3] = {"width", "height", "maxval"};
   std::size_t i = 2;
   long line = 1;
-  std::uint64_t maxval = kind == '1' ? 1 : 0;
+  std::uint64_t maxval = kind == '1' || kind == '4' ? 1 : 0;
+  std::uint64_t dims[3] = {0, 0, 0};
   auto skip = [&] {
     for (;;) {  // whitespace and comments
       while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) line += head[i++] == '\n';
@@ -85,12 +86,32 @@ ImageProblem pnm_problem(std::ifstream& in, std::uint64_t size) {
     }
     if (f == 2 && (v < 1 || v > 65535)) return {line, "PNM maxval " + std::to_string(v) + " (must be 1 to 65535)"};
     if (f == 2) maxval = v;
+    dims[f] = v;
   }
-  if (!ascii) return {};
-  ++i;  // the one whitespace byte after the header
+  // Samples the header promises: a file cut short was OIIO's "unreadable or
+  // unsupported image" (binary) or read with the rest black.
+  const std::uint64_t channels = kind == '3' || kind == '6' ? 3 : 1;
+  const std::uint64_t want = dims[0] * dims[1] * channels;
+  if (!ascii) {
+    const std::uint64_t row = kind == '4' ? (dims[0] + 7) / 8 : dims[0] * channels * (maxval > 255 ? 2 : 1);
+    const std::uint64_t bytes = kind == '4' ? row * dims[1] : row * dims[1];
+    if (size - std::min<std::uint64_t>(size, i + 1) < bytes)
+      return {0, "the PNM data is " + std::to_string(size - std::min<std::uint64_t>(size, i + 1)) + " bytes, " +
+                     std::to_string(bytes) + " expected for " + std::to_string(dims[0]) + "x" +
+                     std::to_string(dims[1]) + " (the file is truncated)"};
+    return {};
+  }
+  if (i < head.size()) line += head[i++] == '\n';  // the one whitespace byte after the header
+  std::uint64_t samples = 0;
   for (;;) {
     skip();
-    if (i >= head.size()) return {};
+    if (i >= head.size()) {
+      if (samples < want)
+        return {line, "the PNM data ends after " + std::to_string(samples) + " of the " + std::to_string(want) +
+                          " samples " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + " takes"};
+      return {};
+    }
+    ++samples;
     if (kind == '1') {  // bits need no separator: "0101"
       if (head[i] != '0' && head[i] != '1') return {line, "PBM bit '" + token() + "' (must be 0 or 1)"};
       ++i;

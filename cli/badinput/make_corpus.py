@@ -306,3 +306,7 @@ put('texture', 'pfm_nan_texel.pfm', b'PF\n2 2\n-1.0\n' + struct.pack('<f', 0.5) 
 # HOSTILE2 F21, F23: the file's own number quoted; a directory named as such.
 put('tolerance', 'pixel_x_2p63.json', '{"width": 8, "height": 8, "pixels": [{"x": 9223372036854775808, "y": 1, "levels": 1, "cause": "c"}]}\n')
 put_dir('tolerance', 'is_a_directory.json')
+# PNM data shorter than the header promises (OIIO: "unreadable or
+# unsupported image", or the rest read as black).
+put('texture', 'p6_truncated.ppm', b'P6\n2 2\n255\n' + b'\x00' * 7)
+put('texture', 'p3_truncated.ppm', 'P3\n2 2\n255\n1 2 3\n')
