@@ -209,7 +209,7 @@ void audit_cases(const Args& a) {
                                     {"t", t_json(ans.t)},
                                     {"answers", answers}};
         // An element of "cases" sits 4 spaces deep in the whole document.
-        std::string text = row.dump(2), indented = "    ";
+        std::string text = row.dump(2, ' ', false, nlohmann::json::error_handler_t::replace), indented = "    ";
         for (char ch : text) {
           indented += ch;
           if (ch == '\n') indented += "    ";
@@ -259,7 +259,7 @@ void grade(const Args& a) {
   if (!a.json.empty()) {
     nlohmann::json j = rep.to_json();
     j["graded"] = {{"answers", a.grade}, {"cases", a.cases}};
-    ra::write_text_atomically(a.json, j.dump(1) + "\n");
+    ra::write_text_atomically(a.json, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
@@ -323,7 +323,7 @@ void audit(const Args& a) {
   std::fputs(rep.summary_table().c_str(), stdout);
   if (opt.shard)
     std::printf("shard %s: partial counts; combine every shard's --json with `rayaudit audit merge`\n", a.shard.c_str());
-  if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
+  if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
@@ -425,7 +425,7 @@ void merge(const Args& a) {
       throw ra::InputError(ra::located(files[i].path, 0, e.what()));
     }
   std::fputs(rep.summary_table().c_str(), stdout);
-  ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
+  ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }

@@ -128,7 +128,7 @@ void run_random(const Args& a) {
   std::string counts;
   for (const auto& [name, k] : causes) counts += (counts.empty() ? "" : ", ") + name + " x" + std::to_string(k);
   if (!counts.empty()) std::cout << "explained pixels by cause: " << counts << "\n";
-  if (!a.out_dir.empty()) ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json", report.dump(2) + "\n");
+  if (!a.out_dir.empty()) ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (unexplained_scenes > 0)
     throw ra::CheckFailed(std::to_string(unexplained_scenes) + " random scenes have pixels no known cause explains" +
                           (a.out_dir.empty() ? std::string(" (give --out DIR for minimal scenes)")
@@ -210,7 +210,7 @@ void run(const Args& a) {
       for (const auto& e : explained) ex.push_back({{"x", e.x}, {"y", e.y}, {"levels", e.levels}, {"cause", e.cause}});
       j["explanations"] = ex;
     }
-    ra::write_text_atomically(a.json_out, j.dump(2) + "\n");
+    ra::write_text_atomically(a.json_out, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   outputs.commit();  // also when the check fails: the diff and JSON say why
   if (a.accept_explained) {

@@ -152,7 +152,7 @@ void run(const Args& a) {
                 m.leaks, m.false_hits);
   }
   j["maps"] = entries;
-  ra::write_text_atomically(outputs[0], j.dump(1) + "\n");
+  ra::write_text_atomically(outputs[0], j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   batch.commit();
   cleanup.armed = false;
   std::cout << "wrote " << maps.size() << " maps and crack_maps.json into " << a.out << "\n";

@@ -83,7 +83,7 @@ void check(const Args& a) {
     failed += !r.pass;
   }
   // Written whatever the verdict: a failed check is what the report must show.
-  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1) + "\n");
+  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   outputs.commit();  // the JSON and the diff images
   if (failed)
     throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +

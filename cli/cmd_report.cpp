@@ -302,7 +302,7 @@ void run(const Args& a) {
                       {"build_type", RAYAUDIT_BUILD_TYPE},
                       {"version", std::string("rayaudit ") + RAYAUDIT_VERSION}}},
                     {"out_dir", tmp.string()}};
-  std::ofstream(tmp / "context.json") << ctx.dump(1);
+  std::ofstream(tmp / "context.json") << ctx.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
   if (const int rc = run_script(tmp / "context.json"); rc != 0)
     throw std::runtime_error("report: " + script().string() + " failed (exit " + std::to_string(rc) + ")");
   const std::string page = read_file(tmp / "index.html"), data = read_file(tmp / "report.json");

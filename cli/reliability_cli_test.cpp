@@ -634,3 +634,24 @@ TEST(ReliabilityCli, ReportRefusesWhatItsScriptCannotTakeInOneLine) {
   }
   fs::remove_all(dir);
 }
+
+// HOSTILE2 F31, F32, F39: a non-UTF-8 CSV id made the JSON writer throw
+// after the work; info read a PLY or a scene as an empty OBJ (exit 0); an
+// OBJ reader trusting st_size read /proc files as empty.
+TEST(ReliabilityCli, NonUtf8IdsInfoOnNonObjAndProcFiles) {
+  const fs::path dir = scratch("f31");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "c.csv") << "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n\xff\xfex,0,0,5,0,0,-1,-1,-1,0,1,-1,0,0,1,0\n";
+  auto r = run_rayaudit("audit --cases " + (dir / "c.csv").string() + " --methods moller --json " + (dir / "o.json").string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(slurp(dir / "o.json").find("\"id\": \"\xEF\xBF\xBD\xEF\xBF\xBDx\""), std::string::npos) << "replaced, valid UTF-8";
+  std::ofstream(dir / "t.ply") << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
+  r = run_rayaudit("info " + (dir / "t.ply").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, (dir / "t.ply").string() + ": a ply file: info reads OBJ meshes (rayaudit convert it to OBJ first)\n");
+  r = run_rayaudit("info /proc/self/status");
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.err.find("/proc/self/status:1: unsupported statement 'Name:'"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}

@@ -427,7 +427,7 @@ void GoldenSet::save(OutputBatch* batch) const {
   std::error_code ec;
   fs::create_directories(root_ / "golden", ec);
   if (batch) batch->add_replacement(root_ / "golden" / "manifest.json");
-  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2) + "\n");
+  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (batch) batch->commit();  // the images and the manifest together
   for (const auto& f : to_remove_) fs::remove(f, ec);
 }

@@ -1266,10 +1266,17 @@ std::string read_file_bytes(const std::filesystem::path& file, std::uint64_t max
                                  std::to_string(max_bytes)));
   std::ifstream f(file, std::ios::binary);
   if (!f) throw InputError(located(file.string(), 0, "cannot open"));
+  // Read to the end, whatever the size said: /proc files say 0 (and were
+  // read as empty), sysfs files 4096 (and were "read failed").
   std::string buf;
-  buf.resize(size_t(size));
-  f.read(buf.data(), std::streamsize(size));
-  if (size_t(f.gcount()) != size) throw InputError(located(file.string(), 0, "read failed"));
+  buf.reserve(size_t(size));
+  char chunk[65536];
+  while (f.read(chunk, sizeof chunk) || f.gcount() > 0) {
+    buf.append(chunk, size_t(f.gcount()));
+    if (buf.size() > max_bytes)
+      throw InputError(located(file.string(), 0, "file is more than the limit of " + std::to_string(max_bytes) + " bytes"));
+  }
+  if (f.bad()) throw InputError(located(file.string(), 0, "read failed: " + std::string(std::strerror(errno))));
   return buf;
 }
 
