@@ -655,3 +655,18 @@ TEST(ReliabilityCli, NonUtf8IdsInfoOnNonObjAndProcFiles) {
   EXPECT_NE(r.err.find("/proc/self/status:1: unsupported statement 'Name:'"), std::string::npos) << r.err;
   fs::remove_all(dir);
 }
+
+// HOSTILE2 F42: an audit JSON with a UTF-8 BOM passed the C++ checks and
+// ended in a 13-line Python traceback; report.py reads it as utf-8-sig.
+TEST(ReliabilityCli, ReportReadsAnAuditJsonWithABom) {
+  const fs::path dir = scratch("report-bom");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path audit = dir / "a.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
+  std::ofstream(dir / "bom.json") << "\xEF\xBB\xBF" << slurp(audit);
+  const auto r = run_rayaudit("report --audit " + (dir / "bom.json").string() + " -o " + (dir / "rep").string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(dir / "rep" / "index.html"));
+  fs::remove_all(dir);
+}

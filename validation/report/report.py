@@ -540,7 +540,7 @@ def images(compare_dirs):
     out = []
     for d in compare_dirs:
         for f in sorted(glob.glob(os.path.join(d, "*.json"))):
-            with open(f) as fh:
+            with open(f, encoding="utf-8-sig") as fh:
                 j = json.load(fh)
             if "identical" not in j or "differences" not in j:
                 continue  # not a compare output (e.g. a tolerance file)
@@ -836,23 +836,23 @@ def main():
     with open(sys.argv[1]) as f:
         ctx = json.load(f)
     methods = Methods(ctx["methods"])
-    with open(ctx["audit"]) as f:
+    with open(ctx["audit"], encoding="utf-8-sig") as f:
         audit = json.load(f)
     bench = None
     if ctx.get("bench"):
-        with open(ctx["bench"]) as f:
+        with open(ctx["bench"], encoding="utf-8-sig") as f:
             bench = json.load(f)
     cm, cm_dir = None, ctx.get("crack_maps")
     if cm_dir:
-        with open(os.path.join(cm_dir, "crack_maps.json")) as f:
+        with open(os.path.join(cm_dir, "crack_maps.json"), encoding="utf-8-sig") as f:
             cm = json.load(f)
     golden = None
     if ctx.get("golden"):
-        with open(ctx["golden"]) as f:
+        with open(ctx["golden"], encoding="utf-8-sig") as f:
             golden = json.load(f)["scenes"]
     stages = []
     if ctx.get("stages"):
-        with open(ctx["stages"]) as f:
+        with open(ctx["stages"], encoding="utf-8-sig") as f:
             for line in f:
                 if line.strip():
                     name, secs = line.rstrip("\n").rsplit("\t", 1)
