@@ -670,3 +670,16 @@ TEST(ReliabilityCli, ReportReadsAnAuditJsonWithABom) {
   EXPECT_TRUE(fs::exists(dir / "rep" / "index.html"));
   fs::remove_all(dir);
 }
+
+// HOSTILE2 F29: the export holds its rows in memory (~850 bytes a case):
+// 10M cases allowed by --rays failed after 10 s with a bare allocation error.
+TEST(ReliabilityCli, ExportCasesBeyondTheMemoryLeftIsRefusedFirst) {
+  SKIP_IF_SANITIZED();
+  const fs::path out = scratch("big-export.csv");
+  const auto r = run_rayaudit("audit --export-cases " + out.string() + " --rays 10000000 --families random --precision double",
+                              "prlimit --as=1000000000 --");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind("--rays: 10000000 cases for each of 1 families need about ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
