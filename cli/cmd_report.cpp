@@ -303,8 +303,12 @@ void run(const Args& a) {
                       {"version", std::string("rayaudit ") + RAYAUDIT_VERSION}}},
                     {"out_dir", tmp.string()}};
   std::ofstream(tmp / "context.json") << ctx.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
-  if (const int rc = run_script(tmp / "context.json"); rc != 0)
+  if (const int rc = run_script(tmp / "context.json"); rc != 0) {
+    // 3: an input the script could not read, said in its one line (an
+    // image beside a compare JSON that PIL cannot open was a traceback).
+    if (rc == 3) throw ra::cli::ExitCode{2};
     throw std::runtime_error("report: " + script().string() + " failed (exit " + std::to_string(rc) + ")");
+  }
   const std::string page = read_file(tmp / "index.html"), data = read_file(tmp / "report.json");
 
   std::error_code ec;

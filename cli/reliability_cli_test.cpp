@@ -683,3 +683,22 @@ TEST(ReliabilityCli, ExportCasesBeyondTheMemoryLeftIsRefusedFirst) {
   EXPECT_EQ(r.err.rfind("--rays: 10000000 cases for each of 1 families need about ", 0), 0u) << r.err;
   EXPECT_FALSE(fs::exists(out));
 }
+
+// HOSTILE2 F40: an image beside a compare JSON that PIL cannot open ended
+// the report in a 13-line traceback; it is one line naming the image.
+TEST(ReliabilityCli, ReportWithAnUnreadableCompareImageIsOneLine) {
+  const fs::path dir = scratch("report-f40");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "cmp");
+  const fs::path audit = dir / "a.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
+  std::ofstream(dir / "cmp" / "x.json") << R"({"width": 8, "height": 8, "differing": 0, "identical": true, "differences": []})";
+  std::ofstream(dir / "cmp" / "x-pov.png") << "not a png\n";
+  const auto r = run_rayaudit("report --audit " + audit.string() + " --compare " + (dir / "cmp").string() + " -o " +
+                              (dir / "rep").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind((dir / "cmp" / "x-pov.png").string() + ": not a readable image (", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "rep"));
+  fs::remove_all(dir);
+}

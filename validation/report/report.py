@@ -50,9 +50,26 @@ def svg_of(fig):
     return text[text.index("<svg"):]
 
 
+class InputFileError(Exception):
+    """A file the C++ checks let through that this script cannot read: one
+    line on stderr, exit 3 (rayaudit then exits 2 without a traceback)."""
+
+
+# compare writes images up to rayaudit's own limit (16384 a side); PIL's
+# decompression-bomb guard stopped at a quarter of that with a traceback.
+Image.MAX_IMAGE_PIXELS = 16384 * 16384
+
+
 def data_uri(path, max_side=THUMB, marks=()):
     """A PNG thumbnail as a data: URI; `marks` (x, y) pixels of the original
     are ringed, so a single differing pixel still shows after shrinking."""
+    try:
+        return _data_uri(path, max_side, marks)
+    except (OSError, ValueError, Image.DecompressionBombError) as e:
+        raise InputFileError(f"{path}: not a readable image ({type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''})")
+
+
+def _data_uri(path, max_side, marks):
     with Image.open(path) as im:
         im = im.convert("RGB")
         w0 = im.size[0]
@@ -895,4 +912,8 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except InputFileError as e:
+        print(str(e).replace("\n", " "), file=sys.stderr)
+        sys.exit(3)
