@@ -148,6 +148,14 @@ void run(const Args& a) {
       throw ra::cli::ExitCode{kSkipped};
     }
   ra::OutputBatch outputs({a.json_out, a.diff_out, a.ours_out, a.pov_out});
+  // Image outputs' formats with the other destination checks, before both
+  // renders (x.jpg failed after them: minutes of POV-Ray lost; HOSTILE2 F44).
+  for (auto [flag, path] : {std::pair{"--diff", &a.diff_out}, {"--ours", &a.ours_out}, {"--pov", &a.pov_out}}) {
+    std::string ext = std::filesystem::path(*path).extension().string();
+    for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (!path->empty() && ext != ".png" && ext != ".exr")
+      throw ra::InputError(ra::located(*path, 0, std::string(flag) + ": unsupported output format (use .png or .exr)"));
+  }
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
   if (a.height > 0) scene.height = a.height;

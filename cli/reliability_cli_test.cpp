@@ -702,3 +702,24 @@ TEST(ReliabilityCli, ReportWithAnUnreadableCompareImageIsOneLine) {
   EXPECT_FALSE(fs::exists(dir / "rep"));
   fs::remove_all(dir);
 }
+
+// HOSTILE2 F44: compare refused --diff x.jpg only after both renders.
+TEST(ReliabilityCli, CompareImageOutputFormatsAreCheckedBeforeTheWork) {
+  for (const char* flag : {"--diff", "--ours", "--pov"}) {
+    const auto r = run_rayaudit("compare " + kScenes + "/doc002-tetrahedron.json --width 8 --height 8 " + flag + " " +
+                                scratch("x.jpg").string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(r.out.empty()) << "nothing rendered: " << r.out;
+    EXPECT_EQ(r.err, scratch("x.jpg").string() + ": " + flag + ": unsupported output format (use .png or .exr)\n");
+  }
+}
+
+// HOSTILE2 F19 addendum: a 10 MB usemtl name was a 10 MB warning line.
+TEST(ReliabilityCli, LongMaterialNamesAreQuotedShort) {
+  const fs::path obj = scratch("long-usemtl.obj");
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl " << std::string(1000000, 'u') << "\nf 1 2 3\n";
+  const auto r = run_rayaudit("info " + obj.string());
+  EXPECT_EQ(r.code, 0) << r.err.substr(0, 300);
+  EXPECT_LT(r.err.size(), 1000u);
+  EXPECT_NE(r.err.find("... (1000000 bytes)' is not defined"), std::string::npos) << r.err.substr(0, 300);
+}

@@ -1014,7 +1014,7 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
         if (!loaded.insert(key).second) continue;
         if (const std::string why = input_file_problem(file); !why.empty()) {
           missing.add(line, located(m.path, line,
-                                       "material library '" + f + "' " +
+                                       "material library '" + short_quote(f) + "' " +
                                            (why == "no such file" ? std::string("not found") : why) +
                                            " (its materials get defaults)"));
           continue;
@@ -1043,7 +1043,7 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
     } else {
       if (opt.load_materials)
         undefined.add(used.lines[i], located(m.path, used.lines[i],
-                                             "material '" + used.names[i] + "' is not defined (default material used)"));
+                                             "material '" + short_quote(used.names[i]) + "' is not defined (default material used)"));
       MtlMaterial d;
       d.name = used.names[i];
       map[i] = int(m.materials.size());
