@@ -723,3 +723,33 @@ TEST(ReliabilityCli, LongMaterialNamesAreQuotedShort) {
   EXPECT_LT(r.err.size(), 1000u);
   EXPECT_NE(r.err.find("... (1000000 bytes)' is not defined"), std::string::npos) << r.err.substr(0, 300);
 }
+
+// HOSTILE2 F43: generate teapot's .inc reader: a malformed number was a raw
+// "stod"; 20 control points, a missing '}' or a 2-component vector were
+// accepted; 1000 patches at --steps 256 took 2.6 GB before failing.
+TEST(ReliabilityCli, TeapotIncErrorsAreLinesAndTheWorkIsEstimated) {
+  SKIP_IF_SANITIZED();
+  const std::string head = "bicubic_patch { type 1 flatness 0.01 u_steps 5 v_steps 5\n";
+  const std::string row = "<1.4, 0, 2.4> <1.4, -0.784, 2.4> <0.784, -1.4, 2.4> <0, -1.4, 2.4>\n";
+  std::string many;
+  for (int i = 0; i < 1000; ++i) many += head + row + row + row + row + "}\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {head + "<1e400, 0, 2.4>" + row.substr(row.find('>') + 1) + row + row + row + "}\n",
+       ":2: vector <1e400, 0, 2.4> needs three finite numbers"},
+      {head + row + row + row + row + row + "}\n", ":1: bicubic_patch with 20 control points (16 needed)"},
+      {head + row + row + row + row, ":1: bicubic_patch without its closing '}'"},
+      {head + "<1,2> " + row + row + row + row + "}\n", ":2: vector <1,2> has 2 components (3 needed)"},
+      {many, ": 1000 patches at --steps 256 make 131072000 triangles, about "}};
+  int i = 0;
+  for (const auto& [text, want] : cases) {
+    const fs::path inc = scratch("t" + std::to_string(i++) + ".inc");
+    std::ofstream(inc) << text;
+    const auto r = run_rayaudit("generate teapot " + inc.string() + " -o " + scratch("t.obj").string() +
+                                    (want.find("steps") != std::string::npos ? " --steps 256" : ""),
+                                "prlimit --as=4000000000 --");
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_EQ(r.err.rfind(inc.string() + want, 0), 0u) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(scratch("t.obj")));
+}
