@@ -32,7 +32,18 @@ std::vector<std::string> names_of(const std::vector<std::string>& given, const r
     std::string rel = p.generic_string();
     if (rel.rfind("scenes/", 0) == 0) rel = rel.substr(7);
     const bool plain = !p.is_absolute() && rel.find("..") == std::string::npos;
-    out.push_back(plain ? rel : p.filename().string());
+    if (!plain) {
+      // A path elsewhere was checked as ROOT/scenes/<its stem>.json, and that
+      // file named in the error (HOSTILE2 F23): a path must be under scenes/.
+      std::error_code ec;
+      const std::filesystem::path scenes = std::filesystem::weakly_canonical(set.root() / "scenes", ec);
+      const std::filesystem::path under = std::filesystem::weakly_canonical(p, ec).lexically_relative(scenes);
+      if (under.empty() || *under.begin() == "..")
+        throw ra::InputError(ra::located(g, 0, "not a scene under " + (set.root() / "scenes").string() +
+                                                   " (golden names scenes by their path there)"));
+      rel = under.generic_string();
+    }
+    out.push_back(rel);
   }
   return out;
 }

@@ -766,3 +766,18 @@ TEST(ReliabilityCli, CrackMapsWorkBeyondItsLimitIsRefusedUpFront) {
   EXPECT_NE(r.err.find("= 1677721600 pixels, more than the limit of 268435456"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
 }
+
+// HOSTILE2 F23: `golden check /elsewhere/x.json` checked ROOT/scenes/x.json
+// and named that file; a path outside scenes/ is refused as such, and an
+// absolute path inside it is its scene.
+TEST(ReliabilityCli, GoldenCheckOfAPathOutsideScenesIsNamedAsSuch) {
+  const std::string root = RAYAUDIT_SOURCE_DIR;
+  auto r = run_rayaudit("golden check /tmp/any/where/x.json --root " + root);
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err.rfind("/tmp/any/where/x.json: not a scene under ", 0), 0u) << r.err;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  r = run_rayaudit("golden check " + root + "/scenes/doc000-pyramid.json --root " + root + " --diff-dir " +
+                   scratch("gd").string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.out.find("ok   doc000-pyramid: identical"), std::string::npos) << r.out;
+}

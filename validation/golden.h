@@ -50,6 +50,7 @@ class GoldenSet {
 
   // Scene names: scenes/*.json stems, and any entries whose scene is gone.
   std::vector<std::string> all_names() const;
+  const std::filesystem::path& root() const { return root_; }
   // The files check(name) reads before any other: its scene and golden image.
   std::vector<std::filesystem::path> inputs_of(const std::string& name) const;
 
