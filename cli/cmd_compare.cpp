@@ -14,6 +14,7 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include <tuple>
 #include "io/input_file.h"
 #include "memory_budget.h"
 #include "golden.h"
@@ -177,6 +178,17 @@ void run(const Args& a) {
   }
   const ra::PovTolerance tol =
       ra::load_pov_tolerance(a.tolerance.empty() ? ra::pov_tolerance_path(a.scene) : std::filesystem::path(a.tolerance));
+  // A tolerance file named on the command line is for this image: one for
+  // 16x16 silently judged nothing of an 8x8 render (HOSTILE2 F21). The
+  // scene's default file keeps its note ("for WxH, not this size: none
+  // apply"), so compare at another --width still runs.
+  if (!a.tolerance.empty())
+    for (auto [key, want, got] : {std::tuple{"width", tol.width, scene.width}, {"height", tol.height, scene.height}})
+      if (want && *want != got)
+        throw ra::InputError(ra::located(a.tolerance, 0, std::string("/") + key + ": " + std::to_string(*want) +
+                                                             ", but the image is " + std::to_string(got) +
+                                                             (key[0] == 'w' ? " wide" : " high") +
+                                                             " (give --width/--height, or a tolerance for this size)"));
 
   ra::RenderOptions opt;
   opt.threads = a.threads;

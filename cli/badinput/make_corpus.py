@@ -310,3 +310,4 @@ put_dir('tolerance', 'is_a_directory.json')
 # unsupported image", or the rest read as black).
 put('texture', 'p6_truncated.ppm', b'P6\n2 2\n255\n' + b'\x00' * 7)
 put('texture', 'p3_truncated.ppm', 'P3\n2 2\n255\n1 2 3\n')
+put('tolerance', 'width_not_the_images.json', '{"width": 16, "height": 16, "pixels": []}\n')
