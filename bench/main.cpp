@@ -11,7 +11,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <new>
 #include <random>
 #include <regex>
@@ -21,6 +24,7 @@
 #include "bench.h"
 #include "errors.h"
 #include "pov_runner.h"
+#include "scene/scene_mesh.h"
 
 // ---- Heap accounting (peak bytes per triangle of the OBJ parsers, bytes of
 // our acceleration structures): every operator new counts its usable size.
@@ -85,6 +89,23 @@ bool option(int argc, char** argv, int& i, const char* name, std::string& value)
   return true;
 }
 
+// Values of the passed-through flags Google Benchmark would take badly
+// (a negative repetition count was "error: vector::reserve", exit 1; an
+// unknown format printed its usage and exited 0; HOSTILE2 F34).
+void check_passthrough(const std::string& arg) {
+  const auto eq = arg.find('=');
+  const std::string name = arg.substr(0, eq), value = eq == std::string::npos ? "" : arg.substr(eq + 1);
+  if (name == "--benchmark_repetitions") {
+    char* end = nullptr;
+    const long n = std::strtol(value.c_str(), &end, 10);
+    if (value.empty() || *end || n < 1 || n > 10000)
+      throw ra::InputError(name + ": must be a whole number from 1 to 10000, got \"" + value + "\"");
+  } else if (name == "--benchmark_format" || name == "--benchmark_out_format") {
+    if (value != "console" && value != "json" && value != "csv")
+      throw ra::InputError(name + ": must be console, json or csv, got \"" + value + "\"");
+  }
+}
+
 Args parse_args(int argc, char** argv) {
   Args a;
   for (int i = 1; i < argc; ++i) {
@@ -107,12 +128,18 @@ Args parse_args(int argc, char** argv) {
     } else if (arg.rfind("--benchmark_out", 0) == 0 || arg.rfind("--benchmark_filter", 0) == 0) {
       throw ra::InputError(arg.substr(0, arg.find('=')) + ": use --json OUT and --filter REGEX instead");
     } else if (arg.rfind("--benchmark_", 0) == 0) {
+      check_passthrough(arg);
       a.passthrough.push_back(arg);
     } else {
       throw ra::InputError("rayaudit bench: unknown argument \"" + arg +
                            "\" (--quick, --json OUT, --threads N, --filter REGEX, --benchmark_*)");
     }
   }
+  // Listing runs nothing: --json was replaced by an empty file (HOSTILE2 F33).
+  if (!a.json.empty())
+    for (const auto& p : a.passthrough)
+      if (p.rfind("--benchmark_list_tests", 0) == 0 && p != "--benchmark_list_tests=false")
+        throw ra::InputError("--benchmark_list_tests: runs no benchmark, so there is nothing for --json: drop one");
   return a;
 }
 
@@ -216,6 +243,16 @@ int run(int argc, char** argv) {
   rb::config().threads_all = a.threads > 0 ? a.threads : int(std::max(1u, std::thread::hardware_concurrency()));
   register_all();
   check_selection(a);
+  // The rows read the mesh corpus: --json naming one of its files replaced
+  // the mesh with the JSON (HOSTILE2 F36).
+  if (!a.json.empty()) {
+    std::error_code ec;
+    const fs::path out = fs::weakly_canonical(a.json, ec), cache = fs::weakly_canonical(ra::cache_dir(), ec);
+    const auto rel = out.lexically_relative(cache);
+    if (!cache.empty() && !rel.empty() && *rel.begin() != ".." && rel.is_relative())
+      throw ra::InputError(ra::located(a.json, 0, "is in the corpus the benchmarks read (" + cache.string() +
+                                                      "): choose another output"));
+  }
   fs::path tmp;
   if (!a.json.empty()) tmp = make_temp_beside(a.json);
   struct RemoveTmp {
@@ -259,10 +296,21 @@ int run(int argc, char** argv) {
     return 1;
   }
   if (!a.json.empty()) {
-    std::error_code ec;
-    fs::rename(tmp, a.json, ec);
-    if (ec) throw ra::InputError(ra::located(a.json, 0, "cannot write: " + ec.message()));
+    // Google Benchmark's writer reports no failed write: on a full disk the
+    // JSON came out cut short and replaced the previous file, exit 0
+    // (HOSTILE2 F35). Its text is checked whole, then written again with
+    // every write, fsync and close checked.
+    std::ifstream in(tmp, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    in.close();
+    fs::remove(tmp);  // its room, for the checked copy
     guard.p.clear();
+    if (!nlohmann::json::accept(text.str()))
+      throw ra::InputError(ra::located(a.json, 0, "cannot write: Google Benchmark's JSON came out incomplete (" +
+                                                      std::to_string(text.str().size()) +
+                                                      " bytes: a full disk?); the previous file is kept"));
+    ra::write_text_atomically(a.json, text.str());
     std::printf("wrote %s\n", a.json.c_str());
   }
   return 0;

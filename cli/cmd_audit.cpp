@@ -22,6 +22,8 @@
 #include "io/file_identity.h"
 #include "grade.h"
 #include "io/input_file.h"
+#include "memory_budget.h"
+#include <new>
 #include "io/json_input.h"
 #include "registry.h"
 
@@ -39,6 +41,7 @@ constexpr long long kMaxExportRays = 10000000;
 
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
+  bool precision_given = false;  // --precision on the command line (not its default)
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
@@ -207,7 +210,7 @@ void audit_cases(const Args& a) {
                                     {"t", t_json(ans.t)},
                                     {"answers", answers}};
         // An element of "cases" sits 4 spaces deep in the whole document.
-        std::string text = row.dump(2), indented = "    ";
+        std::string text = row.dump(2, ' ', false, nlohmann::json::error_handler_t::replace), indented = "    ";
         for (char ch : text) {
           indented += ch;
           if (ch == '\n') indented += "    ";
@@ -233,11 +236,22 @@ void audit_cases(const Args& a) {
   outputs.commit();
 }
 
+// --grade and --export-cases work in one precision: `--precision
+// float,double` given by hand was dropped to double silently (the default,
+// both, still means double).
+std::vector<Precision> one_precision(const Args& a, const char* what) {
+  const auto ps = chosen_precisions(a.precision);
+  if (a.precision_given && ps.size() > 1)
+    throw ra::InputError(std::string("--precision: ") + what + " takes one precision (float or double), got '" +
+                         a.precision + "'");
+  return ps;
+}
+
 // ----------------------------------------------------------- --grade ---
 void grade(const Args& a) {
   if (!a.methods.empty()) throw ra::InputError("audit: --grade grades the answers file, not --methods: drop --methods");
   ra::OutputBatch outputs({a.json, a.csv});
-  const auto ps = chosen_precisions(a.precision);
+  const auto ps = one_precision(a, "--grade");
   // Answers are double unless only float was asked for (as --export-cases).
   const Precision p = ps.size() == 1 ? ps[0] : Precision::f64;
   const std::string method = std::filesystem::path(a.grade).stem().string();
@@ -246,7 +260,7 @@ void grade(const Args& a) {
   if (!a.json.empty()) {
     nlohmann::json j = rep.to_json();
     j["graded"] = {{"answers", a.grade}, {"cases", a.cases}};
-    ra::write_text_atomically(a.json, j.dump(1) + "\n");
+    ra::write_text_atomically(a.json, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
@@ -262,10 +276,24 @@ void export_cases(const Args& a) {
     throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
                          std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
   ra::declare_output(a.export_cases);
-  const auto precisions = chosen_precisions(a.precision);
+  const auto precisions = one_precision(a, "--export-cases");
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
-  const auto rows = export_rows(chosen_families(a.families), p, a.seed, a.rays);
+  const auto fams = chosen_families(a.families);
+  // The rows are held in memory with their CSV text (~850 bytes a case
+  // measured: 2M cases took 1.68 GB, the allowed 10M failed late with a bare
+  // allocation error; HOSTILE2 F29): the estimate is checked first.
+  std::uint64_t families = 0;
+  for (const Family& f : ra::audit::families())
+    if (f.kind == ra::Kind::triangle && !f.secondary &&
+        (fams.empty() || std::find(fams.begin(), fams.end(), f.name) != fams.end()))
+      ++families;
+  const std::uint64_t need = std::uint64_t(a.rays) * families * 900, avail = ra::available_memory();
+  if (need > avail)
+    throw ra::InputError("--rays: " + std::to_string(a.rays) + " cases for each of " + std::to_string(families) +
+                         " families need about " + std::to_string(need >> 20) + " MB to export, but only " +
+                         std::to_string(avail >> 20) + " MB are available: lower --rays or export fewer --families");
+  const auto rows = export_rows(fams, p, a.seed, a.rays);
   if (rows.empty())
     throw ra::InputError("audit: --export-cases needs at least one triangle family other than secondary");
   ra::write_text_atomically(a.export_cases, cases_csv(rows));
@@ -310,7 +338,7 @@ void audit(const Args& a) {
   std::fputs(rep.summary_table().c_str(), stdout);
   if (opt.shard)
     std::printf("shard %s: partial counts; combine every shard's --json with `rayaudit audit merge`\n", a.shard.c_str());
-  if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
+  if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
@@ -322,10 +350,27 @@ struct ShardFile {
   Report report;
 };
 
+// A shard of every method of the registry on every family is about 3 MB;
+// its parsed form takes ~30 times its size, so a 191 MB file ended in a bare
+// std::bad_alloc (HOSTILE2 F26). Larger files are refused from their size.
+constexpr std::uint64_t kMaxShardBytes = std::uint64_t(64) << 20;
+
 ShardFile read_shard(const std::string& path) {
+  ra::check_input_file(path);
+  std::error_code ec;
+  const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kMaxShardBytes)
+    throw ra::InputError(ra::located(path, 0, std::to_string(bytes) + " bytes, more than the " +
+                                                  std::to_string(kMaxShardBytes >> 20) +
+                                                  " MB limit for a shard (one of every method on every family is a few MB)"));
   // read_json_file: a directory or FIFO named, not read or waited on; a
   // syntax error at its line; a key given twice refused.
-  ShardFile f{path, ra::read_json_file(path), {}};
+  ShardFile f{path, {}, {}};
+  try {
+    f.json = ra::read_json_file(path);
+  } catch (const std::bad_alloc&) {
+    throw ra::InputError(ra::located(path, 0, "not enough memory to read this shard"));
+  }
   if (!f.json.is_object() || !f.json.contains("shard"))
     throw ra::InputError(ra::located(path, 0, "not a shard's output (no \"shard\" key: run audit with --shard K/N)"));
   try {
@@ -395,7 +440,7 @@ void merge(const Args& a) {
       throw ra::InputError(ra::located(files[i].path, 0, e.what()));
     }
   std::fputs(rep.summary_table().c_str(), stdout);
-  ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
+  ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
@@ -406,7 +451,7 @@ void setup(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)")
       ->check(ra::cli::non_empty_list());
-  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
+  auto* precision = cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
   cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names())
       ->check(ra::cli::non_empty_list());
   cmd->add_option("--rays", a->rays,
@@ -462,8 +507,9 @@ void setup(CLI::App& app) {
   merge_cmd->add_option("--json", a->json, "Write the merged JSON here")->required();
   merge_cmd->add_option("--csv", a->csv, "Write the merged per-cell CSV here");
   merge_cmd->callback([a] { merge(*a); });
-  cmd->callback([a, merge_cmd] {
+  cmd->callback([a, merge_cmd, precision] {
     if (merge_cmd->parsed()) return;
+    a->precision_given = precision->count() > 0;
     if (!a->grade.empty()) return grade(*a);
     if (!a->cases.empty()) return audit_cases(*a);
     if (!a->export_cases.empty()) return export_cases(*a);

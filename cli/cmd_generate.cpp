@@ -20,7 +20,10 @@
 //       ground, for the height and pov bump variants.
 //     normals: the tangent-space normal map of the same domes (document 002's
 //       variant 1 as read in renderer/shading/bump.h): RGB = (n + 1) / 2.
+#include <algorithm>
 #include <array>
+#include <cctype>
+#include <cstdlib>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -29,6 +32,7 @@
 
 #include "io/atomic_file.h"
 #include "command.h"
+#include "memory_budget.h"
 #include "errors.h"
 #include "io/file_identity.h"
 #include "image.h"
@@ -49,17 +53,45 @@ std::vector<Patch> read_teapot_inc(const std::string& file) {
   ss << in.rdbuf();
   const std::string text = ss.str();
   std::vector<Patch> patches;
-  const std::regex vec(R"(<\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*>)");
+  auto line_of = [&](std::size_t at) { return 1 + long(std::count(text.begin(), text.begin() + long(at), '\n')); };
+  // Each patch: "bicubic_patch { ... 16 vectors <x, y, z> }". A malformed
+  // number was a raw "stod", a 17th vector or a missing brace was ignored,
+  // a 2-component vector skipped (HOSTILE2 F43): each is its line now.
+  const std::regex vec(R"(<([^<>]*)>)");
   for (std::size_t at = text.find("bicubic_patch"); at != std::string::npos;
        at = text.find("bicubic_patch", at + 1)) {
     const std::size_t end = text.find('}', at);
+    if (end == std::string::npos)
+      throw ra::InputError(ra::located(file, line_of(at), "bicubic_patch without its closing '}'"));
     const std::string body = text.substr(at, end - at);
     Patch p;
     int k = 0;
-    for (auto it = std::sregex_iterator(body.begin(), body.end(), vec); it != std::sregex_iterator() && k < 16;
-         ++it, ++k)
-      p[k] = {std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3])};
-    if (k != 16) throw ra::InputError(ra::located(file, 0, "a bicubic_patch without 16 control points"));
+    for (auto it = std::sregex_iterator(body.begin(), body.end(), vec); it != std::sregex_iterator(); ++it, ++k) {
+      const std::size_t where = at + std::size_t(it->position(0));
+      std::string inner = (*it)[1];
+      double x[3];
+      int n = 0;
+      for (std::size_t b = 0; b <= inner.size() && n <= 3;) {
+        const std::size_t c = std::min(inner.find(',', b), inner.size());
+        const std::string tok = inner.substr(b, c - b);
+        char* e = nullptr;
+        const double v = std::strtod(tok.c_str(), &e);
+        while (e && *e && std::isspace(static_cast<unsigned char>(*e))) ++e;
+        if (n < 3 && (e == tok.c_str() || *e || !std::isfinite(v)))
+          throw ra::InputError(ra::located(file, line_of(where), "vector <" + inner.substr(0, 60) +
+                                                                     "> needs three finite numbers"));
+        if (n < 3) x[n] = v;
+        ++n;
+        b = c + 1;
+      }
+      if (n != 3)
+        throw ra::InputError(ra::located(file, line_of(where), "vector <" + inner.substr(0, 60) + "> has " +
+                                                                   std::to_string(n) + " components (3 needed)"));
+      if (k < 16) p[std::size_t(k)] = {x[0], x[1], x[2]};
+    }
+    if (k != 16)
+      throw ra::InputError(ra::located(file, line_of(at), "bicubic_patch with " + std::to_string(k) +
+                                                              " control points (16 needed)"));
     patches.push_back(p);
   }
   if (patches.empty()) throw ra::InputError(ra::located(file, 0, "no bicubic_patch found"));
@@ -83,6 +115,17 @@ Vec3d eval_patch(const Patch& p, double u, double v) {
 void generate_teapot(const std::string& inc, const std::string& out_path, int steps) {
   ra::declare_output(out_path);
   const auto patches = read_teapot_inc(inc);
+  // Vertices (with their weld-map entry and UV) and triangles of every
+  // patch, estimated before the work: 1000 patches at --steps 256 took
+  // 2.6 GB and 14 s, then "not enough memory" naming no file.
+  const std::uint64_t s1 = std::uint64_t(steps) + 1, n = patches.size();
+  const std::uint64_t need = n * s1 * s1 * 160 + n * std::uint64_t(steps) * std::uint64_t(steps) * 2 * 64;
+  if (need > ra::available_memory())
+    throw ra::InputError(ra::located(inc, 0, std::to_string(n) + " patches at --steps " + std::to_string(steps) +
+                                                 " make " + std::to_string(n * std::uint64_t(steps) * std::uint64_t(steps) * 2) +
+                                                 " triangles, about " + std::to_string(need >> 20) + " MB; only " +
+                                                 std::to_string(ra::available_memory() >> 20) +
+                                                 " MB are available: lower --steps"));
   std::vector<Vec3d> positions;
   std::map<std::array<long long, 3>, int> weld;
   auto vertex = [&](const Vec3d& p) {

@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
+#include "io/file_identity.h"
 #include "command.h"
 #include "errors.h"
-#include "io/file_identity.h"
 #include "golden.h"
 
 namespace {
@@ -19,7 +19,6 @@ struct Args {
   std::string root = RAYAUDIT_SOURCE_DIR;
   std::string diff_dir, json;
   bool skip_unavailable = false;
-  bool diff_dir_given = false, json_given = false;
 };
 
 // A scene's name is its path under scenes/ without ".json":
@@ -35,10 +34,20 @@ std::vector<std::string> names_of(const std::vector<std::string>& given, const r
     std::string rel = p.generic_string();
     if (rel.rfind("scenes/", 0) == 0) rel = rel.substr(7);
     const bool plain = !p.is_absolute() && rel.find("..") == std::string::npos;
-    std::string name = plain ? rel : p.filename().string();
+    if (!plain) {
+      // A path elsewhere was checked as ROOT/scenes/<its stem>.json, and that
+      // file named in the error (HOSTILE2 F23): a path must be under scenes/.
+      std::error_code ec;
+      const std::filesystem::path scenes = std::filesystem::weakly_canonical(set.root() / "scenes", ec);
+      const std::filesystem::path under = std::filesystem::weakly_canonical(p, ec).lexically_relative(scenes);
+      if (under.empty() || *under.begin() == "..")
+        throw ra::InputError(ra::located(g, 0, "not a scene under " + (set.root() / "scenes").string() +
+                                                   " (golden names scenes by their path there)"));
+      rel = under.generic_string();
+    }
     // A scene named twice is checked once (its diff images would be two
     // outputs on one path).
-    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(std::move(name));
+    if (std::find(out.begin(), out.end(), rel) == out.end()) out.push_back(rel);
   }
   return out;
 }
@@ -66,42 +75,39 @@ void check_root(const Args& a) {
 }
 
 void check(const Args& a) {
-  if (a.diff_dir_given && a.diff_dir.empty()) throw ra::InputError("--diff-dir: empty path");
-  if (a.json_given && a.json.empty()) throw ra::InputError("--json: empty path");
   check_root(a);
-  const ra::GoldenSet set(a.root);  // the manifest, noted as an input
+  ra::OutputBatch outputs({a.json});
+  const ra::GoldenSet set(a.root);
   const std::filesystem::path diff_dir =
       a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden" : std::filesystem::path(a.diff_dir);
+  int failed = 0, skipped = 0;
+  nlohmann::json rows = nlohmann::json::array();  // for --json (the report's golden section)
   const auto names = names_of(a.scenes, set);
   if (names.empty())
     throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
                          ": no golden images to check");
-  // Every file the check reads that is known now (scenes, golden images),
-  // then every output, before any work: --diff-dir ROOT/golden would
-  // replace the golden it compares with (issue 15's second pass), --json
-  // naming a diff image would lose it. The scenes' meshes and textures are
-  // noted as they load, and refused there if an output names them; all
-  // outputs are renamed into place together at the end (none on exit 2).
+  // Every image a failure may write, declared before the work: the golden
+  // itself (--diff-dir ROOT/golden replaced it with this render, and the
+  // next check passed), --json, or another scene's inputs are refused. In a
+  // folder not there yet (check makes it) an image is declared when written,
+  // so it is still renamed with the others at the end (none on exit 2).
   for (const auto& n : names)
-    for (const auto& in : set.check_inputs(n)) ra::note_input(in);
-  ra::OutputBatch outputs({a.json});
+    for (const std::filesystem::path& in : set.inputs_of(n))
+      if (std::filesystem::is_regular_file(in)) ra::note_input(in);
   check_creatable_dir(diff_dir, "--diff-dir");
-  std::set<std::filesystem::path> later;  // in directories check() creates: declared when written
+  std::set<std::filesystem::path> later;
   for (const auto& n : names)
     for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {
-      if (std::filesystem::is_directory(out.parent_path())) {
+      std::error_code ec;
+      if (std::filesystem::is_directory(out.parent_path(), ec)) {
         outputs.add(out);
-      } else {
-        const auto key = std::filesystem::absolute(out).lexically_normal();
-        if (!later.insert(key).second)
-          throw ra::InputError(ra::located(out.string(), 0, "is named as two outputs of this command: one would be lost"));
+      } else if (!later.insert(std::filesystem::absolute(out).lexically_normal()).second) {
+        throw ra::InputError(ra::located(out.string(), 0, "is named as two outputs of this command: one would be lost"));
       }
     }
   auto before_write = [&](const std::filesystem::path& out) {
     if (later.erase(std::filesystem::absolute(out).lexically_normal())) outputs.add(out);
   };
-  int failed = 0, skipped = 0;
-  nlohmann::json rows = nlohmann::json::array();  // for --json (the report's golden section)
   for (const auto& n : names) {
     const auto missing = ra::missing_cache_inputs(std::filesystem::path(a.root) / "scenes" / (n + ".json"));
     if (a.skip_unavailable && !missing.empty()) {
@@ -118,24 +124,25 @@ void check(const Args& a) {
     failed += !r.pass;
   }
   // Written whatever the verdict: a failed check is what the report must show.
-  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1) + "\n");
-  outputs.commit();
+  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  outputs.commit();  // the JSON and the diff images
   if (failed)
     throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
                           " golden image(s) failed");
   if (skipped == int(names.size())) throw ra::cli::ExitCode{77};
 }
 
+// Every scene is rendered before anything is renamed into golden/: a scene
+// that fails (exit 2) leaves every golden and the manifest as they were
+// (`bless A BAD` rewrote A's image, its manifest entry stale: issue 15).
 void bless(const Args& a) {
   check_root(a);
+  ra::OutputBatch outputs({});
   ra::GoldenSet set(a.root);
-  // Every scene rendered before anything is written (a bad scene after a
-  // good one left the good one's image rewritten and the manifest stale);
-  // what changed is printed once all are written.
-  std::vector<std::string> lines;
-  for (const auto& n : names_of(a.scenes, set)) lines.push_back(set.bless(n));
-  set.save();
-  for (const auto& l : lines) std::cout << l << "\n";
+  std::string said;
+  for (const auto& n : names_of(a.scenes, set)) said += set.bless(n, &outputs) + "\n";
+  set.save(&outputs);
+  std::cout << said;
 }
 
 void setup(CLI::App& app) {
@@ -147,12 +154,10 @@ void setup(CLI::App& app) {
     sub->add_option("scenes", args->scenes, "Scene names or files (default: every scene in scenes/)");
     sub->add_option("--root", args->root, "The repository (holding scenes/ and golden/)");
     if (std::string(name) == "check") {
-      sub->add_option("--diff-dir", args->diff_dir, "Where to write diff images on failure (default /tmp/rayaudit-golden)")
-          ->each([args](const std::string&) { args->diff_dir_given = true; });
+      sub->add_option("--diff-dir", args->diff_dir, "Where to write diff images on failure (default /tmp/rayaudit-golden)");
       sub->add_flag("--skip-unavailable", args->skip_unavailable,
                     "Skip scenes whose ${cache} inputs are missing; exit 77 when all were skipped");
-      sub->add_option("--json", args->json, "Write each scene's status (ok, fail, skip) and message as JSON")
-          ->each([args](const std::string&) { args->json_given = true; });
+      sub->add_option("--json", args->json, "Write each scene's status (ok, fail, skip) and message as JSON");
     }
     sub->callback([args, fn] { fn(*args); });
   };

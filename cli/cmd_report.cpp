@@ -11,12 +11,14 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
 #include "io/input_file.h"
+#include "io/text_lines.h"
 #include "registry.h"
 
 namespace {
@@ -109,19 +111,33 @@ void check_audit(const fs::path& f) {
   need(f, j, "", "rays_per_family", "number");
   const json& subs = need(f, j, "", "subjects", "array");
   if (subs.empty()) throw ra::InputError(f.string() + ": no subjects");
+  // Counts and percentages are never negative: report.py indexed a list
+  // with them (a 14-line traceback; HOSTILE2 F25).
+  auto count = [&](const json& o, const std::string& at, const char* k) {
+    const json& v = need(f, o, at, k, "number");
+    if (!(v.get<double>() >= 0))
+      throw ra::InputError(f.string() + ": " + at + "." + k + ": " + v.dump() + " is negative");
+  };
+  std::set<std::string> names;
   for (std::size_t i = 0; i < subs.size(); ++i) {
     const std::string at = "subjects[" + std::to_string(i) + "]";
     for (const char* k : {"name", "method", "precision", "kind"}) need(f, subs[i], at, k, "string");
+    names.insert(subs[i]["name"].get<std::string>());
     const json& t = need(f, subs[i], at, "totals", "object");
-    for (const char* k : {"tests", "wrong_pct", "leaks", "groups"}) need(f, t, at + ".totals", k, "number");
+    for (const char* k : {"tests", "wrong_pct", "leaks", "groups"}) count(t, at + ".totals", k);
   }
   const json& cells = need(f, j, "", "cells", "array");
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const std::string at = "cells[" + std::to_string(i) + "]";
     for (const char* k : {"subject", "family", "param", "sweep"}) need(f, cells[i], at, k, "string");
+    // report.py splits the subject at its last '/' (METHOD/PRECISION).
+    const std::string subject = cells[i]["subject"].get<std::string>();
+    if (subject.find('/') == std::string::npos || !names.count(subject))
+      throw ra::InputError(f.string() + ": " + at + ": subject '" + subject +
+                           "' is not one of the subjects (METHOD/PRECISION)");
     const json& s = need(f, cells[i], at, "stats", "object");
     for (const char* k : {"tests", "wrong_pct", "leaks", "groups", "double_hits", "spawned", "self_hits"})
-      need(f, s, at + ".stats", k, "number");
+      count(s, at + ".stats", k);
   }
 }
 
@@ -193,7 +209,7 @@ void check_golden(const fs::path& f) {
 void check_stages(const fs::path& f) {
   std::istringstream in(read_file(f));
   std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
+  for (int n = 1; ra::read_text_line(in, line); ++n) {  // \n, \r\n and a lone \r
     if (line.empty()) continue;
     const auto tab = line.rfind('\t');
     char* end = nullptr;
@@ -201,8 +217,9 @@ void check_stages(const fs::path& f) {
     if (tab != std::string::npos) seconds = std::strtod(line.c_str() + tab + 1, &end);
     // A NUL ends strtod's view early (the script then failed with a
     // traceback): the whole field must be the number.
+    // Decimal only: strtod reads C99 hex ("0x10"), report.py's float() does not.
     if (tab == std::string::npos || tab == 0 || !end || end != line.c_str() + line.size() ||
-        end == line.c_str() + tab + 1)
+        end == line.c_str() + tab + 1 || line.find_first_of("xXpP", tab + 1) != std::string::npos)
       throw ra::InputError(ra::located(f.string(), n, "expected STAGE<TAB>SECONDS"));
     // nan, a negative time or 1e400 (inf) were drawn as given.
     if (!std::isfinite(seconds) || seconds < 0)
@@ -285,9 +302,13 @@ void run(const Args& a) {
                       {"build_type", RAYAUDIT_BUILD_TYPE},
                       {"version", std::string("rayaudit ") + RAYAUDIT_VERSION}}},
                     {"out_dir", tmp.string()}};
-  std::ofstream(tmp / "context.json") << ctx.dump(1);
-  if (const int rc = run_script(tmp / "context.json"); rc != 0)
+  std::ofstream(tmp / "context.json") << ctx.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (const int rc = run_script(tmp / "context.json"); rc != 0) {
+    // 3: an input the script could not read, said in its one line (an
+    // image beside a compare JSON that PIL cannot open was a traceback).
+    if (rc == 3) throw ra::cli::ExitCode{2};
     throw std::runtime_error("report: " + script().string() + " failed (exit " + std::to_string(rc) + ")");
+  }
   const std::string page = read_file(tmp / "index.html"), data = read_file(tmp / "report.json");
 
   std::error_code ec;

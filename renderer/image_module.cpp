@@ -3,17 +3,18 @@
 #include "image_module.h"
 
 #include <dlfcn.h>
-#include <sys/resource.h>
-#include <unistd.h>
 
-#include <cstdint>
 #include <cstdlib>
-#include <fstream>
 #include <filesystem>
+#include <algorithm>
+#include <cstdint>
 #include <mutex>
+#include <thread>
 #include <string>
+#include <system_error>
 
 #include "errors.h"
+#include "memory_budget.h"
 
 namespace ra::image_module {
 namespace {
@@ -35,38 +36,47 @@ std::vector<std::string> candidates() {
   return out;
 }
 
-// Address space OpenImageIO needs to load and start: its libraries, and the
-// threads log4cplus starts while the module is opened (each with a stack and
-// a malloc arena), which abort, crash or hang inside dlopen when the system
-// refuses them; with a little less, a valid texture's read failed as
-// "cannot be allocated" (HOSTILE2 F28). Measured on Debian 12: an 8x8
-// textured render needs about 525 MB beside the 10 MB mapped before; with a
-// margin, 560 MB. Refused before dlopen, naming the limit.
-constexpr std::uint64_t kModuleAddressSpace = std::uint64_t(560) << 20;
-
+// OpenImageIO and its ~260 libraries map about 430 MB of address space as
+// they load, and some start threads in their initialisers (log4cplus: 4,
+// each with a stack and a malloc arena). Under an address-space limit
+// (`ulimit -v`, prlimit --as) that leaves less, the load or the first read
+// aborted, segfaulted or hung inside those libraries (410-450 MB: HOSTILE2
+// F28), and up to ~540 MB a valid texture's read failed as "cannot be
+// allocated". Measured on Debian 12 (2 cores): an 8x8 textured render needs
+// about 525 MB beside the 10 MB mapped before; with a margin, 560 MB and a
+// thread stack (8 MB) a core beyond 2. Refused here, before dlopen.
 void check_address_space() {
-  rlimit as{};
-  if (::getrlimit(RLIMIT_AS, &as) != 0 || as.rlim_cur == RLIM_INFINITY) return;
-  std::uint64_t pages = 0;
-  std::ifstream("/proc/self/statm") >> pages;
-  const std::uint64_t mapped = pages * std::uint64_t(::sysconf(_SC_PAGESIZE));
-  const std::uint64_t left = as.rlim_cur > mapped ? as.rlim_cur - mapped : 0;
-  if (left < kModuleAddressSpace)
-    throw InputError("rayaudit: the image module (OpenImageIO) needs about " +
-                     std::to_string(kModuleAddressSpace >> 20) + " MB of address space to load, but the limit (" +
-                     std::to_string(as.rlim_cur >> 20) + " MB, `ulimit -v` / RLIMIT_AS) leaves " +
-                     std::to_string(left >> 20) + " MB: raise it");
+  const std::uint64_t cores = std::max(2u, std::thread::hardware_concurrency());
+  const std::uint64_t need = (std::uint64_t(560) << 20) + (std::uint64_t(8) << 20) * (cores - 2);
+  const std::uint64_t left = address_space_left();
+  if (left < need)
+    throw InputError(located(kFileName, 0,
+                             "the image module (OpenImageIO) needs about " + std::to_string(need >> 20) +
+                                 " MB of address space to load, but only " + std::to_string(left >> 20) +
+                                 " MB are left under the address-space limit (`ulimit -v`): raise it"));
 }
 
 const Api* load() {
-  check_address_space();
   std::string tried;
   for (const std::string& path : candidates()) {
     const bool by_name = path.find('/') == std::string::npos;
     std::error_code ec;
     tried += (tried.empty() ? "" : ", ") + (by_name ? "the library path" : path);
     if (!by_name && !fs::exists(path, ec)) continue;
-    void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    void* handle = nullptr;
+    try {
+      // Through a pointer of a type that may throw: glibc declares dlopen
+      // noexcept, and the handler would be compiled away.
+      void* (*volatile open_fn)(const char*, int) = ::dlopen;
+      handle = open_fn(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    } catch (const std::system_error& e) {
+      // OpenImageIO's dependencies start threads in their initialisers: under
+      // a low `ulimit -v` that throws out of dlopen ("rayaudit: error:
+      // Resource temporarily unavailable", naming nothing).
+      throw InputError(located(by_name ? std::string(kFileName) : path, 0,
+                               std::string("cannot load the image module: ") + e.what() +
+                                   " (a library's thread could not start: is the address-space limit `ulimit -v` too low?)"));
+    }
     if (!handle) {
       // A file that is there but does not load (a missing OpenImageIO
       // library, a wrong architecture) is the answer, not the next place.
@@ -94,7 +104,10 @@ const Api& api() {
   static std::mutex m;
   static const Api* loaded = nullptr;
   std::lock_guard<std::mutex> lock(m);
-  if (!loaded) loaded = load();
+  if (!loaded) {
+    check_address_space();
+    loaded = load();
+  }
   return *loaded;
 }
 

@@ -3,6 +3,7 @@
 #include "audit.h"
 
 #include <algorithm>
+#include <set>
 #include <atomic>
 #include <cmath>
 #include <cstdarg>
@@ -188,6 +189,31 @@ Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
   };
   read("t_ulps", s.ulp_hist);
   read("t_rel", s.rel_hist);
+  // A shard is the output of an audit: unknown keys (a typo, an edit) and
+  // counts no audit produces were merged as given (HOSTILE2 F27).
+  static const std::set<std::string> kStats = {
+      "tests", "true_hits", "false_hits", "true_misses", "false_misses", "boundary_hits", "boundary_misses",
+      "coplanar_hits", "coplanar_misses", "degenerate_hits", "degenerate_misses", "nan_inf", "wrong_t", "groups",
+      "leaks", "double_hits", "spawned", "self_hits", "t_samples", "t_ulps_max", "t_ulps_median", "t_rel_max",
+      "t_rel_median", "wrong", "wrong_pct"};
+  for (const auto& [k, v] : j.items())
+    if (!kStats.count(k)) throw std::runtime_error("stats: unknown key '" + k + "'");
+  for (const auto& [k, v] : h.items())
+    if (k != "t_ulps" && k != "t_rel") throw std::runtime_error("histograms: unknown key '" + k + "'");
+  const std::uint64_t outcomes = s.true_hits + s.false_hits + s.true_misses + s.false_misses + s.boundary_hits +
+                                 s.boundary_misses + s.coplanar_hits + s.coplanar_misses + s.degenerate_hits +
+                                 s.degenerate_misses;
+  if (outcomes != s.tests)
+    throw std::runtime_error("stats: the outcomes (hits, misses, boundary, coplanar, degenerate) add up to " +
+                             std::to_string(outcomes) + ", not tests " + std::to_string(s.tests));
+  for (auto [k, v] : {std::pair{"wrong_t", s.wrong_t}, {"nan_inf", s.nan_inf}, {"double_hits", s.double_hits},
+                      {"t_samples", s.t_samples}, {"groups", s.groups}})
+    if (v > s.tests)
+      throw std::runtime_error(std::string("stats: ") + k + " " + std::to_string(v) + " exceeds tests " +
+                               std::to_string(s.tests));
+  if (s.self_hits > s.spawned)
+    throw std::runtime_error("stats: self_hits " + std::to_string(s.self_hits) + " exceeds spawned " +
+                             std::to_string(s.spawned));
   return s;
 }
 
@@ -689,7 +715,11 @@ Report Report::from_json(const nlohmann::json& j) {
       const auto w = std::find(f->sweep.begin(), f->sweep.end(), cell.sweep_label);
       cell.sweep = int(w - f->sweep.begin());
     }
-    cell.stats = Stats::from_json(need(c, "stats"), c.contains("histograms") ? c["histograms"] : nlohmann::json());
+    try {  // which cell, for a file of thousands
+      cell.stats = Stats::from_json(need(c, "stats"), c.contains("histograms") ? c["histograms"] : nlohmann::json());
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "]: " + e.what());
+    }
     r.cells.push_back(std::move(cell));
   }
   return r;

@@ -147,29 +147,13 @@ GoldenEntry entry_from(const json& j, const std::string& at, const Fail& fail) {
   }
   e.settings = default_settings();
   if (j.contains("settings")) {
+    // Values are checked by settings_problem() (as render checks its flags);
+    // a key it does not know is an error here, not ignored.
     const json& s = j.at("settings");
-    const std::string sat = at + "/settings";
-    if (!s.is_object()) fail(sat, "expected an object, got " + shown(s));
-    for (auto it = s.begin(); it != s.end(); ++it) {
-      const std::string where = sat + "/" + it.key();
-      if (!e.settings.contains(it.key())) fail(where, "unknown key");
-      const json& v = it.value();
-      if (it.key() == "spp") {
-        const int spp = integer(v, where, 1, 256, "");
-        const int n = int(std::lround(std::sqrt(double(spp))));
-        if (n * n != spp) fail(where, "must be a square number of samples (1, 4, 9, ...), got " + v.dump());
-      } else {
-        const std::string name = string(v, where);
-        bool ok = true;
-        if (it.key() == "triangle_method") ok = find_method(name) && find_method(name)->kind == Kind::triangle;
-        else if (it.key() == "sphere_method") ok = find_method(name) && find_method(name)->kind == Kind::sphere;
-        else if (it.key() == "precision") ok = name == "float" || name == "double";
-        else if (it.key() == "self_intersection") ok = parse_self_intersection(name).has_value();
-        else if (it.key() == "accel") ok = parse_accel(name).has_value();
-        if (!ok) fail(where, "\"" + name + "\" is not a valid value");
-      }
-      e.settings[it.key()] = v;
-    }
+    if (s.is_object())
+      for (auto it = s.begin(); it != s.end(); ++it)
+        if (!e.settings.contains(it.key())) fail(at + "/settings/" + it.key(), "unknown key");
+    e.settings = s;
   }
   e.inputs_hash = string(need("inputs_hash"), at + "/inputs_hash");
   if (j.contains("inputs")) {
@@ -197,6 +181,56 @@ std::string entry_problem(const GoldenEntry& e) {
   if (!inside_root(e.name)) return "name \"" + e.name + "\" must be a relative path without \"..\"";
   if (!inside_root(e.scene)) return "scene \"" + e.scene + "\" must be a relative path under the root without \"..\"";
   if (!inside_root(e.image)) return "image \"" + e.image + "\" must be a relative path under the root without \"..\"";
+  if (e.width < 1 || e.height < 1 || e.width > int(kMaxImageSide) || e.height > int(kMaxImageSide))
+    return "size " + std::to_string(e.width) + "x" + std::to_string(e.height) + " is not 1 to " +
+           std::to_string(kMaxImageSide) + " pixels a side";
+  if (e.bits != 8 && e.bits != 16) return "bits must be 8 or 16, got " + std::to_string(e.bits);
+  return "";
+}
+
+// The render settings a golden records, checked as `render` checks its
+// flags (a manifest's spp of 2 was rendered at 1, a wrong method name
+// failed later naming no manifest): "" or the problem; *key names the
+// setting.
+std::string settings_problem(const json& s, std::string* key) {
+  if (!s.is_object()) return *key = "", "settings must be an object";
+  auto text = [&](const char* k, std::string& v) {
+    *key = k;
+    if (!s.contains(k)) return true;
+    if (!s.at(k).is_string()) return false;
+    v = s.at(k).get<std::string>();
+    return true;
+  };
+  std::string v;
+  for (auto [k, kind] : {std::pair{"triangle_method", Kind::triangle}, {"sphere_method", Kind::sphere}}) {
+    v.clear();
+    if (!text(k, v)) return "expected a string";
+    const Method* m = v.empty() ? nullptr : find_method(v);
+    if (s.contains(k) && (!m || m->kind != kind))
+      return "unknown " + std::string(kind == Kind::triangle ? "triangle" : "sphere") + " method \"" + v +
+             "\"; valid: " + method_names(kind);
+  }
+  v.clear();
+  if (!text("precision", v)) return "expected a string";
+  if (s.contains("precision") && v != "float" && v != "double") return "precision must be float or double, got \"" + v + "\"";
+  v.clear();
+  if (!text("self_intersection", v)) return "expected a string";
+  if (s.contains("self_intersection") && !parse_self_intersection(v))
+    return "unknown self_intersection \"" + v + "\"";
+  v.clear();
+  if (!text("accel", v)) return "expected a string";
+  if (s.contains("accel") && !parse_accel(v)) return "unknown accel \"" + v + "\"";
+  *key = "spp";
+  if (s.contains("spp")) {
+    const json& n = s.at("spp");
+    if (!n.is_number_integer()) return "spp must be an integer";
+    const long long spp = n.get<long long>();
+    bool square = false;
+    for (long long a = 1; a <= 16; ++a) square = square || a * a == spp;
+    if (!square)
+      return "spp must be a square number of samples per pixel (1, 4, 9, ... 256) as for render --spp, got " +
+             std::to_string(spp);
+  }
   return "";
 }
 
@@ -271,25 +305,37 @@ std::string combined_hash(const std::map<std::string, std::string>& inputs) {
 GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
   const fs::path m = root_ / "golden" / "manifest.json";
   if (!fs::exists(m)) return;
-  const json j = read_json_file(m.string());  // FILE:LINE errors, duplicate keys refused
+  JsonLines lines;  // every error names its line
+  const json j = read_json_file(m.string(), &lines);  // FILE:LINE errors, duplicate keys refused
   try {
     if (!j.is_object() || !j.contains("goldens") || !j.at("goldens").is_array())
-      throw InputError(m.string() + ": expected an object with a \"goldens\" array");
+      throw InputError(located(m.string(), lines.at("/goldens"), "expected an object with a \"goldens\" array"));
     const json& all = j.at("goldens");
     for (std::size_t i = 0; i < all.size(); ++i) {
-      const std::string at = m.string() + ": /goldens/" + std::to_string(i);
+      const std::string ptr = "/goldens/" + std::to_string(i);
+      const std::string at = located(m.string(), lines.at(ptr), ptr);
       if (!all[i].is_object()) throw InputError(at + ": expected an object");
-      const GoldenEntry g = entry_from(all[i], "/goldens/" + std::to_string(i),
-                                       [&](const std::string& where, const std::string& what) {
-                                         throw InputError(located(m.string(), 0, where + ": " + what));
-                                       });
+      const GoldenEntry g = entry_from(all[i], ptr, [&](const std::string& where, const std::string& what) {
+        throw InputError(located(m.string(), lines.at(where), where + ": " + what));
+      });
       if (const std::string why = entry_problem(g); !why.empty()) throw InputError(at + ": " + why);
+      std::string key;
+      if (const std::string why = settings_problem(g.settings, &key); !why.empty()) {
+        const std::string sp = ptr + "/settings" + (key.empty() ? "" : "/" + key);
+        throw InputError(located(m.string(), lines.at(sp), sp + ": " + why));
+      }
       if (entries_.count(g.name)) throw InputError(at + ": golden \"" + g.name + "\" listed twice");
       entries_[g.name] = g;
     }
   } catch (const json::exception& e) {
     throw InputError(m.string() + ": " + json_error_text(e));
   }
+}
+
+std::vector<std::filesystem::path> GoldenSet::inputs_of(const std::string& name) const {
+  std::vector<fs::path> out{root_ / "scenes" / (name + ".json")};
+  if (auto it = entries_.find(name); it != entries_.end()) out.push_back(root_ / it->second.image);
+  return out;
 }
 
 std::vector<std::string> GoldenSet::all_names() const {
@@ -313,12 +359,6 @@ Image render_golden(const fs::path& scene_file, int w, int h, const json& settin
 }
 
 }  // namespace
-
-std::vector<fs::path> GoldenSet::check_inputs(const std::string& name) const {
-  std::vector<fs::path> out{root_ / "scenes" / (name + ".json")};
-  if (auto it = entries_.find(name); it != entries_.end()) out.push_back(root_ / it->second.image);
-  return out;
-}
 
 std::vector<fs::path> GoldenSet::diff_outputs(const std::string& name, const fs::path& diff_dir) {
   return {diff_dir / (name + ".diff.png"), diff_dir / (name + ".png")};
@@ -358,8 +398,7 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
     return {false, msg};
   }
   std::error_code ec;
-  const auto paths = diff_outputs(name, diff_dir);
-  const fs::path &diff = paths[0], &mine = paths[1];
+  const fs::path diff = diff_dir / (name + ".diff.png"), mine = diff_dir / (name + ".png");
   fs::create_directories(diff.parent_path(), ec);  // names may hold a folder: corpus/ladder-10-box
   if (before_write) before_write(diff);
   write_image(diff, difference_image(ours, golden, g.bits));
@@ -375,14 +414,14 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
   return {false, msg};
 }
 
-std::string GoldenSet::bless(const std::string& name) {
+std::string GoldenSet::bless(const std::string& name, OutputBatch* batch) {
   const fs::path scene_file = root_ / "scenes" / (name + ".json");
   if (!fs::exists(scene_file)) {
     auto it = entries_.find(name);
     if (it == entries_.end()) throw InputError(scene_file.string() + ": no such scene");
-    pending_removal_.push_back(root_ / it->second.image);
-    pending_.erase(root_ / it->second.image);
+    to_remove_.push_back(root_ / it->second.image);  // when the manifest is saved
     entries_.erase(it);
+    removed_ = true;
     return name + ": removed (its scene is gone)";
   }
   GoldenEntry g;
@@ -424,12 +463,17 @@ std::string GoldenSet::bless(const std::string& name) {
     else
       what += "; inputs unchanged";
   }
-  if (write_png) pending_[root_ / g.image] = img;
+  std::error_code ec;
+  fs::create_directories((root_ / g.image).parent_path(), ec);
+  if (write_png) {
+    if (batch) batch->add_replacement(root_ / g.image);
+    write_image(root_ / g.image, img, {8, false});
+  }
   entries_[name] = g;
   return what;
 }
 
-void GoldenSet::save() {
+void GoldenSet::save(OutputBatch* batch) const {
   json all = json::array();
   for (const auto& [n, e] : entries_) all.push_back(to_json(e));
   json j = {{"about", "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
@@ -437,22 +481,10 @@ void GoldenSet::save() {
             {"goldens", all}};
   std::error_code ec;
   fs::create_directories(root_ / "golden", ec);
-  for (const auto& [path, img] : pending_) fs::create_directories(path.parent_path(), ec);
-  {
-    // Each image replaces the golden it was compared with (an input of
-    // this run, so not declared as an output: io/file_identity.h would
-    // refuse it); all renamed together after the last is written.
-    OutputBatch batch({});
-    const fs::path manifest = root_ / "golden" / "manifest.json";
-    batch.add_replacement(manifest);
-    for (const auto& [path, img] : pending_) batch.add_replacement(path);
-    for (const auto& [path, img] : pending_) write_image(path, img, {8, false});
-    write_text_atomically(manifest, j.dump(2) + "\n");
-    batch.commit();
-  }
-  pending_.clear();
-  for (const auto& p : pending_removal_) fs::remove(p, ec);
-  pending_removal_.clear();
+  if (batch) batch->add_replacement(root_ / "golden" / "manifest.json");
+  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (batch) batch->commit();  // the images and the manifest together
+  for (const auto& f : to_remove_) fs::remove(f, ec);
 }
 
 }  // namespace ra

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "image.h"
 #include "image_compare.h"
+#include "io/atomic_file.h"
 #include "scene/scene.h"
 
 namespace ra {
@@ -51,40 +51,36 @@ class GoldenSet {
 
   // Scene names: scenes/*.json stems, and any entries whose scene is gone.
   std::vector<std::string> all_names() const;
+  const std::filesystem::path& root() const { return root_; }
+  // The files check(name) reads before any other: its scene and golden image.
+  std::vector<std::filesystem::path> inputs_of(const std::string& name) const;
 
   struct Result {
     bool pass = false;
     std::string message;  // what was found, with the diff image's path on failure
   };
-  // The files check(name) reads that exist now: the scene file and the
-  // golden image (the scene's meshes and textures are known once it is
-  // loaded). A command notes them as inputs (io/file_identity.h) before
-  // declaring its outputs, so --diff-dir ROOT/golden is refused before any work.
-  std::vector<std::filesystem::path> check_inputs(const std::string& name) const;
-
+  // Renders `name` and compares with its golden; on failure writes
+  // diff_dir/NAME.diff.png (false colour) and diff_dir/NAME.png (ours).
   // The images check() writes for `name` on failure, in this order.
   static std::vector<std::filesystem::path> diff_outputs(const std::string& name,
                                                          const std::filesystem::path& diff_dir);
-
-  // Renders `name` and compares with its golden; on failure writes
-  // diff_dir/NAME.diff.png (false colour) and diff_dir/NAME.png (ours),
-  // calling before_write(path) first (after creating its directory).
+  // before_write(path) is called before each diff image is written (after
+  // its directory is made): a command declares outputs in new folders then.
   Result check(const std::string& name, const std::filesystem::path& diff_dir,
                const std::function<void(const std::filesystem::path&)>& before_write = {}) const;
 
-  // Renders `name` and records it in memory; returns a line saying what
-  // changed. Nothing is written before save(), which writes every blessed
-  // image and the manifest together (all or none: a scene that fails to
-  // load after others were blessed leaves golden/ as it was), then removes
-  // the goldens of scenes that are gone.
-  std::string bless(const std::string& name);
-  void save();
+  // Renders `name` and records it; returns a line saying what changed.
+  // save() writes the manifest.
+  // With `batch`, the image and (save) the manifest are staged in it: a
+  // later failure leaves golden/ as it was (commit() renames them).
+  std::string bless(const std::string& name, OutputBatch* batch = nullptr);
+  void save(OutputBatch* batch = nullptr) const;
 
  private:
   std::filesystem::path root_;
   std::map<std::string, GoldenEntry> entries_;
-  std::map<std::filesystem::path, Image> pending_;      // blessed images, written by save()
-  std::vector<std::filesystem::path> pending_removal_;  // goldens of removed scenes
+  bool removed_ = false;
+  std::vector<std::filesystem::path> to_remove_;  // goldens of removed scenes: deleted by save()
 };
 
 }  // namespace ra

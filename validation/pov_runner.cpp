@@ -1,6 +1,8 @@
 #include "pov_runner.h"
 
 #include <fcntl.h>
+#include <cstring>
+#include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -40,6 +42,37 @@ struct WorkDir {
 };
 
 
+// The child being waited for, and the signal that interrupted the wait: a
+// SIGINT/SIGTERM/SIGHUP sent to rayaudit alone (timeout, kill) left POV-Ray
+// rendering as an orphan and its working directory in /tmp (HOSTILE2 F30).
+// The handler only forwards the signal (kill is async-signal-safe); the
+// waiter then throws, so the working directory is removed on the way out.
+volatile sig_atomic_t g_child = 0;
+volatile sig_atomic_t g_signal = 0;
+
+extern "C" void forward_signal(int sig) {
+  g_signal = sig;
+  if (g_child > 0) ::kill(pid_t(g_child), sig);
+}
+
+// Installs forward_signal for the wait; restores the previous handlers.
+struct ForwardSignals {
+  static constexpr int kSignals[3] = {SIGINT, SIGTERM, SIGHUP};
+  struct sigaction old[3];
+  explicit ForwardSignals(pid_t child) {
+    g_signal = 0;
+    g_child = child;
+    struct sigaction sa {};
+    sa.sa_handler = forward_signal;
+    sigemptyset(&sa.sa_mask);
+    for (int i = 0; i < 3; ++i) sigaction(kSignals[i], &sa, &old[i]);
+  }
+  ~ForwardSignals() {
+    for (int i = 0; i < 3; ++i) sigaction(kSignals[i], &old[i], nullptr);
+    g_child = 0;
+  }
+};
+
 }  // namespace
 
 ProcessRun run_process(const fs::path& dir, const std::vector<std::string>& argv, const fs::path& out,
@@ -64,8 +97,15 @@ ProcessRun run_process(const fs::path& dir, const std::vector<std::string>& argv
   int status = 0;
   rusage ru{};
   ProcessRun run;
-  while (wait4(pid, &status, 0, &ru) < 0)
-    if (errno != EINTR) return run;
+  {
+    const ForwardSignals forward(pid);
+    if (g_signal) ::kill(pid, g_signal);  // arrived between fork and here
+    while (wait4(pid, &status, 0, &ru) < 0)
+      if (errno != EINTR) return run;
+  }
+  if (g_signal)
+    throw InputError(std::string(argv[0]) + ": interrupted by signal " + std::to_string(int(g_signal)) +
+                     " (" + strsignal(int(g_signal)) + "); the child was stopped and its files removed");
   run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run.cpu_s = double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

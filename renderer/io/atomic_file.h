@@ -50,9 +50,8 @@ class OutputBatch {
   OutputBatch& operator=(const OutputBatch&) = delete;
   // Adds an output known only later (e.g. a texture copied beside a .pov).
   void add(const std::filesystem::path& output);
-  // An output that deliberately replaces one of this run's inputs (`golden
-  // bless` rewrites the golden it compared with): check_output_path() only,
-  // no identity check; staged and renamed with the others.
+  // Adds an output that rewrites one of the command's inputs on purpose
+  // (golden bless: the golden it compared against): only the path is checked.
   void add_replacement(const std::filesystem::path& output);
   void commit();
 

@@ -50,9 +50,26 @@ def svg_of(fig):
     return text[text.index("<svg"):]
 
 
+class InputFileError(Exception):
+    """A file the C++ checks let through that this script cannot read: one
+    line on stderr, exit 3 (rayaudit then exits 2 without a traceback)."""
+
+
+# compare writes images up to rayaudit's own limit (16384 a side); PIL's
+# decompression-bomb guard stopped at a quarter of that with a traceback.
+Image.MAX_IMAGE_PIXELS = 16384 * 16384
+
+
 def data_uri(path, max_side=THUMB, marks=()):
     """A PNG thumbnail as a data: URI; `marks` (x, y) pixels of the original
     are ringed, so a single differing pixel still shows after shrinking."""
+    try:
+        return _data_uri(path, max_side, marks)
+    except (OSError, ValueError, Image.DecompressionBombError) as e:
+        raise InputFileError(f"{path}: not a readable image ({type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''})")
+
+
+def _data_uri(path, max_side, marks):
     with Image.open(path) as im:
         im = im.convert("RGB")
         w0 = im.size[0]
@@ -540,7 +557,7 @@ def images(compare_dirs):
     out = []
     for d in compare_dirs:
         for f in sorted(glob.glob(os.path.join(d, "*.json"))):
-            with open(f) as fh:
+            with open(f, encoding="utf-8-sig") as fh:
                 j = json.load(fh)
             if "identical" not in j or "differences" not in j:
                 continue  # not a compare output (e.g. a tolerance file)
@@ -836,23 +853,23 @@ def main():
     with open(sys.argv[1]) as f:
         ctx = json.load(f)
     methods = Methods(ctx["methods"])
-    with open(ctx["audit"]) as f:
+    with open(ctx["audit"], encoding="utf-8-sig") as f:
         audit = json.load(f)
     bench = None
     if ctx.get("bench"):
-        with open(ctx["bench"]) as f:
+        with open(ctx["bench"], encoding="utf-8-sig") as f:
             bench = json.load(f)
     cm, cm_dir = None, ctx.get("crack_maps")
     if cm_dir:
-        with open(os.path.join(cm_dir, "crack_maps.json")) as f:
+        with open(os.path.join(cm_dir, "crack_maps.json"), encoding="utf-8-sig") as f:
             cm = json.load(f)
     golden = None
     if ctx.get("golden"):
-        with open(ctx["golden"]) as f:
+        with open(ctx["golden"], encoding="utf-8-sig") as f:
             golden = json.load(f)["scenes"]
     stages = []
     if ctx.get("stages"):
-        with open(ctx["stages"]) as f:
+        with open(ctx["stages"], encoding="utf-8-sig") as f:
             for line in f:
                 if line.strip():
                     name, secs = line.rstrip("\n").rsplit("\t", 1)
@@ -895,4 +912,8 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except InputFileError as e:
+        print(str(e).replace("\n", " "), file=sys.stderr)
+        sys.exit(3)
