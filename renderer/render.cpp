@@ -274,9 +274,13 @@ struct Tracer::Impl {
         window.tmax = T(t);
       }
     };
-    for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
-      if (only >= 0 && int(oi) != only) continue;
-      const Object& o = scene.objects[oi];
+    // The bounds read once (the hits written below could alias them).
+    const Object* const objects = scene.objects.data();
+    const std::size_t n_objects = scene.objects.size();
+    const std::size_t first = only >= 0 ? std::min(std::size_t(only), n_objects) : 0,
+                      last = only >= 0 ? std::min(std::size_t(only) + 1, n_objects) : n_objects;
+    for (std::size_t oi = first; oi < last; ++oi) {
+      const Object& o = objects[oi];
       switch (o.kind) {
         case Object::Kind::sphere: {
           if (auto h = sph_method->sphere<T>().hit(window, Vec3<T>(o.sphere.center), T(o.sphere.radius)))
@@ -397,8 +401,10 @@ struct Tracer::Impl {
   // Is anything in the ray's window? (shadow rays) Inlined as closest_impl.
   template <class T, bool kFma>
   [[gnu::always_inline]] inline bool occluded_impl(const Ray<T>& r) const {
-    for (std::size_t oi = 0; oi < scene.objects.size(); ++oi) {
-      const Object& o = scene.objects[oi];
+    const Object* const objects = scene.objects.data();
+    const std::size_t count = scene.objects.size();
+    for (std::size_t oi = 0; oi < count; ++oi) {
+      const Object& o = objects[oi];
       switch (o.kind) {
         case Object::Kind::sphere:
           if (sph_method->sphere<T>().any(r, Vec3<T>(o.sphere.center), T(o.sphere.radius))) return true;
