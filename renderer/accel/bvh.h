@@ -168,11 +168,9 @@ inline constexpr PlaneOffsets kPlaneOffsets[8] = {
 template <class T>
 [[gnu::always_inline]] inline v4f lanes(const Vec3<T>& v, float w) {
   if constexpr (sizeof(T) == 8) {
-    typedef double v4d __attribute__((vector_size(32)));
-    v4d x;
-    __builtin_memcpy(&x, &v, 3 * sizeof(double));
-    x[3] = double(w);
-    return __builtin_convertvector(x, v4f);
+    // SSE2 (so usable in this generic code): x, y in one load.
+    const __m128 xy = _mm_cvtpd_ps(_mm_loadu_pd(&v.x)), zw = _mm_cvtpd_ps(_mm_set_pd(double(w), v.z));
+    return (v4f)_mm_movelh_ps(xy, zw);
   } else {
     v4f x;
     __builtin_memcpy(&x, &v, 3 * sizeof(float));
