@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <cerrno>
 #include <map>
 #include <filesystem>
 #include <fstream>
@@ -43,6 +45,7 @@ struct Args {
   std::uint64_t seed = 1;
   int threads = 0;
   std::vector<std::string> merge_inputs;
+  bool precision_given = false;  // --precision on the command line (not the default)
 };
 
 // "K/N" with 1 <= K <= N <= kMaxShards, or an error message.
@@ -207,7 +210,7 @@ void audit_cases(const Args& a) {
                                     {"t", t_json(ans.t)},
                                     {"answers", answers}};
         // An element of "cases" sits 4 spaces deep in the whole document.
-        std::string text = row.dump(2), indented = "    ";
+        std::string text = row.dump(2, ' ', false, nlohmann::json::error_handler_t::replace), indented = "    ";
         for (char ch : text) {
           indented += ch;
           if (ch == '\n') indented += "    ";
@@ -246,7 +249,7 @@ void grade(const Args& a) {
   if (!a.json.empty()) {
     nlohmann::json j = rep.to_json();
     j["graded"] = {{"answers", a.grade}, {"cases", a.cases}};
-    ra::write_text_atomically(a.json, j.dump(1) + "\n");
+    ra::write_text_atomically(a.json, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
@@ -257,19 +260,33 @@ void export_cases(const Args& a) {
   if (!a.json.empty() || !a.csv.empty())
     throw ra::InputError("audit: --export-cases writes only the cases CSV; run the audit separately for --json/--csv");
   if (!a.methods.empty()) throw ra::InputError("audit: --export-cases exports cases, not methods' answers: drop --methods");
-  // The export holds its rows in memory before writing them (~350 bytes each).
+  // The rows are streamed to the file (memory does not grow with --rays);
+  // the limit bounds the file (about 350 bytes a case) and the time.
   if (a.rays > kMaxExportRays)
     throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
-                         std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
-  ra::declare_output(a.export_cases);
+                         std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each on disk)");
   const auto precisions = chosen_precisions(a.precision);
+  // One file holds one precision's inputs (HOSTILE2 F1: a list of two was
+  // taken as double and the float half dropped silently).
+  if (a.precision_given && precisions.size() != 1)
+    throw ra::InputError("--precision: --export-cases takes one precision (float or double), got '" + a.precision + "'");
+  ra::declare_output(a.export_cases);
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
-  const auto rows = export_rows(chosen_families(a.families), p, a.seed, a.rays);
-  if (rows.empty())
-    throw ra::InputError("audit: --export-cases needs at least one triangle family other than secondary");
-  ra::write_text_atomically(a.export_cases, cases_csv(rows));
-  std::printf("wrote %zu %s cases to %s\n", rows.size(), precision_name(p), a.export_cases.c_str());
+  const auto fams = chosen_families(a.families);
+  bool any = false;
+  for_each_export_row(fams, p, a.seed, 1, [&](const ra::audit::ExportRow&) { any = true; });
+  if (!any) throw ra::InputError("audit: --export-cases needs at least one triangle family other than secondary");
+  long long rows = 0;
+  ra::write_atomically(a.export_cases, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out << ra::audit::cases_csv_header();
+    rows = for_each_export_row(fams, p, a.seed, a.rays,
+                               [&](const ra::audit::ExportRow& r) { out << ra::audit::cases_csv_row(r); });
+    out.close();
+    if (!out) throw ra::InputError(ra::located(a.export_cases, 0, std::string("cannot write: ") + std::strerror(errno)));
+  });
+  std::printf("wrote %lld %s cases to %s\n", rows, precision_name(p), a.export_cases.c_str());
 }
 
 // ------------------------------------------------------------ audit ---
@@ -310,7 +327,7 @@ void audit(const Args& a) {
   std::fputs(rep.summary_table().c_str(), stdout);
   if (opt.shard)
     std::printf("shard %s: partial counts; combine every shard's --json with `rayaudit audit merge`\n", a.shard.c_str());
-  if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
+  if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
@@ -395,7 +412,7 @@ void merge(const Args& a) {
       throw ra::InputError(ra::located(files[i].path, 0, e.what()));
     }
   std::fputs(rep.summary_table().c_str(), stdout);
-  ra::write_text_atomically(a.json, rep.to_json().dump(1) + "\n");
+  ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
@@ -462,10 +479,11 @@ void setup(CLI::App& app) {
   merge_cmd->add_option("--json", a->json, "Write the merged JSON here")->required();
   merge_cmd->add_option("--csv", a->csv, "Write the merged per-cell CSV here");
   merge_cmd->callback([a] { merge(*a); });
-  cmd->callback([a, merge_cmd] {
+  cmd->callback([a, merge_cmd, cmd] {
     if (merge_cmd->parsed()) return;
     if (!a->grade.empty()) return grade(*a);
     if (!a->cases.empty()) return audit_cases(*a);
+    a->precision_given = cmd->count("--precision") > 0;
     if (!a->export_cases.empty()) return export_cases(*a);
     audit(*a);
   });

@@ -447,9 +447,8 @@ long long probes_per_sweep(const Family& f, int sweep, long long rays) {
   return std::max(1LL, per);
 }
 
-std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
-                                   long long rays) {
-  std::vector<ProbeCase> out;
+void for_each_probe_case(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays,
+                         const std::function<void(const ProbeCase&)>& visit) {
   const long long n = probes_per_sweep(f, sweep, rays);
   for (long long c = 0; c * kChunk < n; ++c) {
     TriangleBatch b;
@@ -461,9 +460,15 @@ std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std:
         pc.tris.push_back(t);
         pc.answers.push_back(oracle::triangle(pr.ray, t.a, t.b, t.c));
       }
-      out.push_back(std::move(pc));
+      visit(pc);
     }
   }
+}
+
+std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
+                                   long long rays) {
+  std::vector<ProbeCase> out;
+  for_each_probe_case(f, sweep, p, seed, rays, [&](const ProbeCase& pc) { out.push_back(pc); });
   return out;
 }
 
