@@ -70,4 +70,128 @@ TEST(Hostile2Cli, ExportCasesStreamsWithinAFixedAddressSpace) {
   fs::remove(out);
 }
 
+// F22: a --mesh whose path is one of the maps was overwritten by that map.
+TEST(Hostile2Cli, CrackMapsMeshThatIsAnOutputIsRefused) {
+  const fs::path dir = scratch("cm-identity");
+  fs::create_directories(dir);
+  const fs::path mesh = dir / "sphere-moller-1.png";
+  fs::copy_file(kScenes + "/meshes/tetrahedron.obj", mesh, fs::copy_options::overwrite_existing);
+  const std::string before = slurp(mesh);
+  const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + mesh.string() +
+                              " --methods moller --offsets 1 --size 8");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find(mesh.string() + ": is also an input of this command"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(mesh), before);
+  EXPECT_FALSE(fs::exists(dir / "crack_maps.json"));
+}
+
+// F38: the flags' own limits multiplied to ~34 hours, run silently.
+TEST(Hostile2Cli, CrackMapsAbsurdWorkIsRefusedWithItsSize) {
+  const fs::path dir = scratch("cm-absurd");
+  const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + kScenes +
+                              "/meshes/tetrahedron.obj --size 1024 --offsets 1,10,100,1000,1e4");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, "crack-maps: 80 maps of 1024x1024 pixels are 83886080 pixels (about 104 core-minutes); the "
+                   "limit is 16777216: fewer --offsets or --methods, or a smaller --size\n");
+  EXPECT_FALSE(fs::exists(dir));
+}
+
+// F31: a non-UTF-8 byte in a file name or a CSV id made the JSON writers
+// throw nlohmann's type_error after the work; the bytes are now written as
+// U+FFFD and the JSON is valid.
+TEST(Hostile2Cli, NonUtf8NamesAndIdsGiveValidJson) {
+  const fs::path mesh = scratch("te\xff.obj");
+  fs::copy_file(kScenes + "/meshes/tetrahedron.obj", mesh, fs::copy_options::overwrite_existing);
+  const fs::path maps = scratch("cm-latin1");
+  fs::remove_all(maps);
+  auto r = run_rayaudit("crack-maps -o " + maps.string() + " --mesh '" + mesh.string() +
+                        "' --methods moller --offsets 1 --size 8");
+  ASSERT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(slurp(maps / "crack_maps.json").find("\"name\": \"te\xef\xbf\xbd\""), std::string::npos);
+
+  const fs::path cases = scratch("latin1-id.csv"), out = scratch("latin1-id.json");
+  std::ofstream(cases) << "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
+                          "\xff\xfe\"x,0,0,5,0,0,-1,-1,-1,0,1,-1,0,0,1,0\n";
+  r = run_rayaudit("audit --cases " + cases.string() + " --methods moller --json " + out.string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(slurp(out).find("\"id\": \"\xef\xbf\xbd\xef\xbf\xbd\\\"x\""), std::string::npos) << slurp(out);
+}
+
+// F25: inputs the C++ checks let through ended in Python tracebacks.
+TEST(Hostile2Cli, ReportRefusesWhatThePageCannotDrawInOneLine) {
+  const fs::path audit = scratch("rep-audit.json");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json " + audit.string()).code, 0);
+  const std::string text = slurp(audit);
+  auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+    const fs::path p = scratch(name);
+    std::ofstream(p) << t;
+    return p;
+  };
+  struct Case {
+    fs::path file;
+    std::string extra, message;
+  };
+  const fs::path stages = scratch("hex.tsv");
+  std::ofstream(stages) << "a\t0x10\n";
+  const std::vector<Case> cases = {
+      {variant("rep-subject.json", "\"subject\": \"moller/float\"", "\"subject\": \"moller\""), "",
+       ": cells[0]: subject 'moller' is not METHOD/PRECISION"},
+      {variant("rep-negative.json", "\"tests\": ", "\"tests\": -5, \"was\": "), "", " is negative"},
+      {audit, " --stages " + stages.string(), "hex.tsv:1: expected STAGE<TAB>SECONDS"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = scratch("rep-out");
+    const auto r = run_rayaudit("report --audit " + c.file.string() + c.extra + " -o " + out.string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// F42: a UTF-8 byte-order mark before the audit JSON (the C++ check took it,
+// the script's json.load did not).
+TEST(Hostile2Cli, ReportReadsAnAuditJsonWithAByteOrderMark) {
+  const fs::path audit = scratch("bom-audit.json"), out = scratch("bom-report");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json " + audit.string()).code, 0);
+  const std::string text = slurp(audit);
+  std::ofstream(audit, std::ios::binary) << "\xef\xbb\xbf" << text;
+  const auto r = run_rayaudit("report --audit " + audit.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(out / "index.html"));
+  fs::remove_all(out);
+}
+
+// F40: a corrupt or huge image beside a compare JSON ended in a PIL
+// traceback; now one line naming the image, exit 2, nothing written.
+TEST(Hostile2Cli, ReportNamesAnUnreadableOrHugeImageInOneLine) {
+  const fs::path audit = scratch("img-audit.json"), dir = scratch("img-cmp");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json " + audit.string()).code, 0);
+  fs::create_directories(dir);
+  std::ofstream(dir / "x.json") << R"({"width": 8, "height": 8, "differing": 0, "identical": true, "differences": []})";
+  std::ofstream(dir / "x-pov.png") << "not a png\n";
+  const fs::path out = scratch("img-report");
+  auto r = run_rayaudit("report --audit " + audit.string() + " --compare " + dir.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("x-pov.png: not a readable image"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // A PNG header declaring 16384 x 16384 (what compare --width 16384 writes):
+  // refused from its size, not decoded (PIL's bomb error was 15 lines).
+  std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x40\0\0\0\x40\0\x08\x02\0\0\0", 29);
+  png += "\x26\xaa\x87\xd3";  // the IHDR chunk's CRC (PIL checks it on opening)
+  png += std::string("\0\0\0\0IEND\xae\x42\x60\x82", 12);  // PIL reads the next chunk's header too
+  std::ofstream(dir / "x-pov.png", std::ios::binary) << png;
+  r = run_rayaudit("report --audit " + audit.string() + " --compare " + dir.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("x-pov.png: 16384x16384 is too large to show in the report"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
