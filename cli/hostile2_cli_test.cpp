@@ -2,6 +2,15 @@
 // F30, F31, F40, F42, F43, F44): audit export/merge, report, crack-maps,
 // compare and generate, run through the real program as a user would.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <set>
+#include <thread>
+
+#include <fcntl.h>
 
 #include <filesystem>
 #include <fstream>
@@ -192,6 +201,63 @@ TEST(Hostile2Cli, ReportNamesAnUnreadableOrHugeImageInOneLine) {
   EXPECT_TRUE(one_line(r.err)) << r.err;
   EXPECT_NE(r.err.find("x-pov.png: 16384x16384 is too large to show in the report"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+std::set<fs::path> pov_work_dirs() {
+  std::set<fs::path> out;
+  for (const auto& e : fs::directory_iterator("/tmp"))
+    if (e.path().filename().string().rfind("rayaudit-pov-", 0) == 0) out.insert(e.path());
+  return out;
+}
+
+// Processes whose working directory is `dir` (POV-Ray runs in its own).
+int processes_in(const fs::path& dir) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    std::error_code ec;
+    if (fs::read_symlink(e.path() / "cwd", ec) == dir && !ec) ++n;
+  }
+  return n;
+}
+
+// F30: an interrupted compare left POV-Ray running as an orphan and its
+// working directory in /tmp. Now the signal kills POV-Ray, removes the
+// directory and ends rayaudit with that signal.
+TEST(Hostile2Cli, InterruptedCompareLeavesNoPovRayAndNoDirectory) {
+  for (const int sig : {SIGTERM, SIGINT}) {
+    const std::set<fs::path> before = pov_work_dirs();
+    const std::string exe = RAYAUDIT_EXE, scene = kScenes + "/sphere-on-plane.json";
+    std::vector<std::string> args{exe, "compare", scene, "--width", "2000", "--height", "2000"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    // (fork/exec: the project's renderer/spawn.h hides <spawn.h>.)
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const int null = open("/dev/null", O_WRONLY);
+      dup2(null, 1);
+      dup2(null, 2);
+      execv(exe.c_str(), argv.data());
+      _exit(127);
+    }
+    // Wait (at most 60 s) until POV-Ray runs in a new working directory.
+    fs::path work;
+    for (int i = 0; i < 600 && work.empty(); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      for (const auto& d : pov_work_dirs())
+        if (!before.count(d) && processes_in(d) > 0) work = d;
+    }
+    ASSERT_FALSE(work.empty()) << "POV-Ray never started";
+    kill(pid, sig);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status;
+    // SIGKILL is immediate, the reaping is not: allow a moment.
+    for (int i = 0; i < 50 && processes_in(work) > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_EQ(processes_in(work), 0) << "POV-Ray still running in " << work;
+    EXPECT_FALSE(fs::exists(work)) << work;
+  }
 }
 
 }  // namespace
