@@ -260,4 +260,54 @@ TEST(Hostile2Cli, InterruptedCompareLeavesNoPovRayAndNoDirectory) {
   }
 }
 
+// F27: impossible counts and unknown keys in a shard were merged as given;
+// F26: a hostile shard was held at ~30x its size (a bare std::bad_alloc).
+TEST(Hostile2Cli, MergeRefusesImpossibleStatsUnknownKeysAndHugeShards) {
+  const fs::path sh1 = scratch("sh1.json"), sh2 = scratch("sh2.json"), out = scratch("merged.json");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 1/2 --json " + sh1.string()).code, 0);
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 2/2 --json " + sh2.string()).code, 0);
+  const std::string text = slurp(sh1);
+  auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+    const fs::path p = scratch(name);
+    std::ofstream(p) << t;
+    return p;
+  };
+  // false_hits 1000 in a cell of 10 tests (the number replaced in place).
+  const fs::path false_hits = scratch("m-false-hits.json");
+  std::string fh = text;
+  const auto at = fh.find("\"false_hits\": ");
+  const auto end = fh.find(',', at);
+  fh.replace(at, end - at, "\"false_hits\": 1000");
+  std::ofstream(false_hits) << fh;
+  struct Case {
+    fs::path file;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {false_hits, ": cells[0].stats: the verdict counts add up to "},
+      {variant("m-unknown.json", "\"tests\": ", "\"zz\": 1, \"tests\": "), ": cells[0].stats: 'zz': unknown key"},
+      {variant("m-hist.json", "\"t_rel\": ", "\"zz\": [], \"t_rel\": "), ": cells[0].histograms: 'zz': unknown key"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_rayaudit("audit merge " + c.file.string() + " " + sh2.string() + " --json " + out.string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find(c.file.string() + c.message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // 9 MB of JSON (spaces are JSON too): refused by its size, before parsing.
+  const fs::path big = scratch("m-big.json");
+  std::ofstream(big) << text.substr(0, text.size() - 2) << std::string(9u << 20, ' ') << "}\n";
+  const auto r = run_rayaudit("audit merge " + big.string() + " " + sh2.string() + " --json " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, big.string() + ": 9 MB is larger than a shard can be (at most 8 MB; a full audit's shard is about 1 MB)\n");
+  EXPECT_FALSE(fs::exists(out));
+  // The untouched shards still merge.
+  EXPECT_EQ(run_rayaudit("audit merge " + sh1.string() + " " + sh2.string() + " --json " + out.string()).code, 0);
+}
+
 }  // namespace
