@@ -310,4 +310,44 @@ TEST(Hostile2Cli, MergeRefusesImpossibleStatsUnknownKeysAndHugeShards) {
   EXPECT_EQ(run_rayaudit("audit merge " + sh1.string() + " " + sh2.string() + " --json " + out.string()).code, 0);
 }
 
+// F43: generate teapot took 1e400 as a bare "stod", accepted malformed
+// patches, and tessellated any number of patches at --steps 256 (16.8 GB).
+TEST(Hostile2Cli, TeapotIncIsCheckedAndItsWorkBounded) {
+  const std::string head = "bicubic_patch { type 1 flatness 0.01 u_steps 5 v_steps 5\n";
+  const std::string row = "<1.4, 0, 2.4> <1.4, -0.784, 2.4> <0.784, -1.4, 2.4> <0, -1.4, 2.4>\n";
+  const std::string patch = head + row + row + row + row + "}\n";
+  struct Case {
+    std::string name, text, message;
+    int steps;
+  };
+  const std::vector<Case> cases = {
+      {"e.inc", head + "<1e400, 0, 2.4> <1.4, -0.784, 2.4> <0.784, -1.4, 2.4> <0, -1.4, 2.4>\n" + row + row + row + "}\n",
+       "e.inc:2: number '1e400' is not a finite number within 1e30", 8},
+      {"twenty.inc", head + row + row + row + row + row + "}\n", "twenty.inc:1: bicubic_patch with 20 control points (16 needed)", 8},
+      {"unclosed.inc", head + row + row + row + row, "unclosed.inc:1: bicubic_patch without a closed { ... }", 8},
+      {"two.inc", head + "<1,2> " + row + row + row + row + "}\n", "two.inc:2: vector with 2 components (3 needed)", 8},
+      {"many.inc", [&] {
+         std::string t;
+         for (int i = 0; i < 100; ++i) t += patch;
+         return t;
+       }(),
+       "many.inc: 100 patches at --steps 256 make 13107200 triangles (about 5242 MB); at most 1048576: a smaller --steps",
+       256},
+  };
+  const fs::path out = scratch("teapot.obj");
+  for (const auto& c : cases) {
+    const fs::path inc = scratch(c.name);
+    std::ofstream(inc) << c.text;
+    const auto r = run_rayaudit("generate teapot " + inc.string() + " -o " + out.string() + " --steps " +
+                                std::to_string(c.steps));
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_EQ(r.err, scratch("").string() + c.message + "\n");
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // One good patch still tessellates.
+  const fs::path good = scratch("good.inc");
+  std::ofstream(good) << patch;
+  EXPECT_EQ(run_rayaudit("generate teapot " + good.string() + " -o " + out.string()).code, 0);
+}
+
 }  // namespace
