@@ -125,6 +125,30 @@ TEST(Hostile2Cli, NonUtf8NamesAndIdsGiveValidJson) {
   r = run_rayaudit("audit --cases " + cases.string() + " --methods moller --json " + out.string());
   ASSERT_EQ(r.code, 0) << r.all;
   EXPECT_NE(slurp(out).find("\"id\": \"\xef\xbf\xbd\xef\xbf\xbd\\\"x\""), std::string::npos) << slurp(out);
+  // A graded answers file whose name is not UTF-8: the subject is named after it.
+  const fs::path exported = scratch("latin1-export.csv"), answers = scratch("ans\xff.csv");
+  ASSERT_EQ(run_rayaudit("audit --export-cases " + exported.string() + " --families edge --rays 10").code, 0);
+  {
+    std::ifstream in(exported);
+    std::ofstream a(answers);
+    a << "id,hit,t\n";
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) a << line.substr(0, line.find(',')) << ",false,\n";
+  }
+  const fs::path graded = scratch("latin1-graded.json");
+  r = run_rayaudit("audit --grade '" + answers.string() + "' --cases " + exported.string() + " --json " + graded.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(slurp(graded).find("ans\xef\xbf\xbd"), std::string::npos);
+  // report from a directory whose name is not UTF-8: the script opens it.
+  const fs::path dir = scratch("d\xff");
+  fs::create_directories(dir);
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json '" + (dir / "a.json").string() + "'").code, 0);
+  const fs::path rep = scratch("latin1-report");
+  r = run_rayaudit("report --audit '" + (dir / "a.json").string() + "' -o " + rep.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(rep / "index.html"));
+  fs::remove_all(rep);
 }
 
 // F25: inputs the C++ checks let through ended in Python tracebacks.
