@@ -210,13 +210,13 @@ void check_stages(const fs::path& f) {
     if (tab != std::string::npos) seconds = std::strtod(line.c_str() + tab + 1, &end);
     // A NUL ends strtod's view early (the script then failed with a
     // traceback): the whole field must be the number.
+    if (tab == std::string::npos || tab == 0 || !end || end != line.c_str() + line.size() ||
+        end == line.c_str() + tab + 1)
+      throw ra::InputError(ra::located(f.string(), n, "expected STAGE<TAB>SECONDS"));
     // Decimal only: strtod also takes C99 hex ("0x10"), which the page's
     // Python float() refuses (HOSTILE2 F25).
-    const bool decimal = tab != std::string::npos &&
-                         line.find_first_not_of("0123456789.eE+-", tab + 1) == std::string::npos;
-    if (tab == std::string::npos || tab == 0 || !end || end != line.c_str() + line.size() ||
-        end == line.c_str() + tab + 1 || !decimal)
-      throw ra::InputError(ra::located(f.string(), n, "expected STAGE<TAB>SECONDS"));
+    if (line.find_first_not_of("0123456789.eE+-", tab + 1) != std::string::npos)
+      throw ra::InputError(ra::located(f.string(), n, "seconds '" + line.substr(tab + 1, 40) + "' is not a decimal number"));
     // nan, a negative time or 1e400 (inf) were drawn as given.
     if (!std::isfinite(seconds) || seconds < 0)
       throw ra::InputError(ra::located(f.string(), n, "seconds must be a finite number >= 0"));

@@ -175,7 +175,7 @@ TEST(Hostile2Cli, ReportRefusesWhatThePageCannotDrawInOneLine) {
       {variant("rep-subject.json", "\"subject\": \"moller/float\"", "\"subject\": \"moller\""), "",
        ": cells[0]: subject 'moller' is not METHOD/PRECISION"},
       {variant("rep-negative.json", "\"tests\": ", "\"tests\": -5, \"was\": "), "", " is negative"},
-      {audit, " --stages " + stages.string(), "hex.tsv:1: expected STAGE<TAB>SECONDS"},
+      {audit, " --stages " + stages.string(), "hex.tsv:1: seconds '0x10' is not a decimal number"},
   };
   for (const auto& c : cases) {
     const fs::path out = scratch("rep-out");

@@ -3,8 +3,10 @@
 # as data: URIs, one self-contained index.html and the report.json behind it.
 #
 # Run by `rayaudit report` (cli/cmd_report.cpp) with /usr/bin/python3, which has
-# Debian's matplotlib; that command has already checked every input, so this
-# script trusts their shape and reads them as given in CONTEXT.json.
+# Debian's matplotlib; that command has already checked every input's shape.
+# What only this script can find (an image PIL cannot read or too large to
+# show, anything unforeseen) is one line naming the input and exit 2, never a
+# traceback; rayaudit report then exits 2 without a line of its own.
 import base64
 import datetime
 import glob
