@@ -17,6 +17,7 @@
 #include <sstream>
 #include <string>
 
+#include "io/full_disk.h"
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;
@@ -372,6 +373,21 @@ TEST(Hostile2Cli, TeapotIncIsCheckedAndItsWorkBounded) {
   const fs::path good = scratch("good.inc");
   std::ofstream(good) << patch;
   EXPECT_EQ(run_rayaudit("generate teapot " + good.string() + " -o " + out.string()).code, 0);
+}
+
+// The streamed export on a full disk: one line, exit 2, the old file kept
+// (the rows now go to the file as they are made; the write is still checked
+// through close and rename).
+TEST(Hostile2Cli, StreamedExportOnAFullDiskKeepsTheOldFile) {
+  ra::test::FullDisk disk;
+  if (!disk.ok()) GTEST_SKIP() << disk.why_not();
+  const fs::path out = disk.dir() / "cases.csv";
+  std::ofstream(out) << "good";
+  const auto r = run_rayaudit("audit --export-cases " + out.string() + " --families edge --rays 1000");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find(out.string() + ": cannot write"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out), "good");
 }
 
 }  // namespace
