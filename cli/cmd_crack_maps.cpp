@@ -2,6 +2,7 @@
 // with each triangle method in float, leaks painted red (validation/crack_maps.h).
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -67,11 +68,25 @@ constexpr double kMaxPixelMaps = 16777216;
 // The ladder's closed mesh the maps use unless --mesh is given.
 std::filesystem::path default_ladder_mesh() { return ra::cache_dir() / "corpus" / "ladder" / "elephant_cgal.obj"; }
 
+// Progress: redrawn in place on a terminal; otherwise (CI logs) a line
+// every 10 s with an estimate of the rest, as audit prints (HOSTILE2 F38:
+// silent for hours), so a long run shows it is alive and how long it has.
 std::function<void(std::size_t, std::size_t)> progress_count() {
-  if (!isatty(STDERR_FILENO)) return {};
-  return [](std::size_t done, std::size_t total) {
-    std::fprintf(stderr, "\rcrack maps: %zu/%zu mesh x offset", done, total);
-    if (done == total) std::fprintf(stderr, "\r%40s\r", "");
+  using clock = std::chrono::steady_clock;
+  if (isatty(STDERR_FILENO))
+    return [](std::size_t done, std::size_t total) {
+      std::fprintf(stderr, "\rcrack maps: %zu/%zu mesh x offset", done, total);
+      if (done == total) std::fprintf(stderr, "\r%40s\r", "");
+      std::fflush(stderr);
+    };
+  const auto start = clock::now();
+  return [start, last = start](std::size_t done, std::size_t total) mutable {
+    const auto now = clock::now();
+    if (done >= total || std::chrono::duration<double>(now - last).count() < 10) return;
+    last = now;
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    std::fprintf(stderr, "crack maps: %zu/%zu mesh x offset, about %.0f s left\n", done, total,
+                 elapsed / double(done) * double(total - done));
     std::fflush(stderr);
   };
 }
