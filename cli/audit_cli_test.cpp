@@ -294,14 +294,15 @@ TEST(AuditShards, HostileShardsAreOneLineErrors) {
     EXPECT_FALSE(fs::exists(out));
   };
   auto jb = nlohmann::json::parse(slurp(b));
-  jb["cells"][0]["stats"]["tests"] = std::numeric_limits<std::uint64_t>::max();
+  // tests at 2^64-1 with the verdict counts still adding up to it (merge
+  // refuses counts that do not), merged with a shard of a few tests.
+  auto& sb = jb["cells"][0]["stats"];
+  const std::uint64_t max = std::numeric_limits<std::uint64_t>::max();
+  sb["true_misses"] = sb["true_misses"].get<std::uint64_t>() + (max - sb["tests"].get<std::uint64_t>());
+  sb["tests"] = max;
   const fs::path big = tmp("hbig.json");
   write(big, jb.dump());
-  auto ja = nlohmann::json::parse(slurp(a));
-  ja["cells"][0]["stats"]["tests"] = 20;
-  const fs::path small = tmp("hsmall.json");
-  write(small, ja.dump());
-  one_error(small, big, big.string() + ": a count overflows 2^64-1 when merged");
+  one_error(a, big, big.string() + ": a count overflows 2^64-1 when merged");
   auto huge = [&](const fs::path& from, const fs::path& to) {
     auto j = nlohmann::json::parse(slurp(from));
     j["shard"]["n"] = 4000000000ULL;

@@ -127,7 +127,7 @@ void run_random(const Args& a) {
   std::string counts;
   for (const auto& [name, k] : causes) counts += (counts.empty() ? "" : ", ") + name + " x" + std::to_string(k);
   if (!counts.empty()) std::cout << "explained pixels by cause: " << counts << "\n";
-  if (!a.out_dir.empty()) ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json", report.dump(2) + "\n");
+  if (!a.out_dir.empty()) ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (unexplained_scenes > 0)
     throw ra::CheckFailed(std::to_string(unexplained_scenes) + " random scenes have pixels no known cause explains" +
                           (a.out_dir.empty() ? std::string(" (give --out DIR for minimal scenes)")
@@ -146,6 +146,14 @@ void run(const Args& a) {
                 << ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)\n";
       throw ra::cli::ExitCode{kSkipped};
     }
+  // Image formats checked with the other destination checks, before both
+  // renders (HOSTILE2 F44: found only after minutes of POV-Ray).
+  for (const std::string* out : {&a.diff_out, &a.ours_out, &a.pov_out}) {
+    std::string ext = std::filesystem::path(*out).extension().string();
+    for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (!out->empty() && ext != ".png" && ext != ".exr")
+      throw ra::InputError(*out + ": unsupported output format (use .png or .exr)");
+  }
   ra::OutputBatch outputs({a.json_out, a.diff_out, a.ours_out, a.pov_out});
   ra::Scene scene = ra::load_scene(a.scene);
   if (a.width > 0) scene.width = a.width;
@@ -206,7 +214,7 @@ void run(const Args& a) {
       for (const auto& e : explained) ex.push_back({{"x", e.x}, {"y", e.y}, {"levels", e.levels}, {"cause", e.cause}});
       j["explanations"] = ex;
     }
-    ra::write_text_atomically(a.json_out, j.dump(2) + "\n");
+    ra::write_text_atomically(a.json_out, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
   outputs.commit();  // also when the check fails: the diff and JSON say why
   if (a.accept_explained) {

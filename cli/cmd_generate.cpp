@@ -20,11 +20,11 @@
 //       ground, for the height and pov bump variants.
 //     normals: the tangent-space normal map of the same domes (document 002's
 //       variant 1 as read in renderer/shading/bump.h): RGB = (n + 1) / 2.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 
 #include "io/atomic_file.h"
@@ -41,6 +41,37 @@ namespace {
 using ra::Vec3d;
 using Patch = std::array<Vec3d, 16>;  // row-major: 4 rows of 4 control points
 
+// 1-based line of byte `at`, for positions asked in increasing order
+// (counted on from the last one: linear in the file, not quadratic).
+struct LineOf {
+  const std::string& text;
+  std::size_t pos = 0;
+  long line = 1;
+  long operator()(std::size_t at) {
+    at = std::min(at, text.size());
+    if (at < pos) pos = 0, line = 1;
+    line += long(std::count(text.begin() + std::ptrdiff_t(pos), text.begin() + std::ptrdiff_t(at), '\n'));
+    pos = at;
+    return line;
+  }
+};
+
+// One number of a vector: all of the text a decimal number, finite and
+// within the scene limit (HOSTILE2 F43: 1e400 was a bare "stod").
+double inc_number(const std::string& file, long line, std::string s) {
+  const auto b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
+  s = b == std::string::npos ? "" : s.substr(b, e - b + 1);
+  char* end = nullptr;
+  const double v = s.empty() || s.find_first_not_of("+-0123456789.eE") != std::string::npos
+                       ? NAN : std::strtod(s.c_str(), &end);
+  if (s.empty() || !end || *end || !std::isfinite(v) || std::fabs(v) > 1e30)
+    throw ra::InputError(ra::located(file, line, "number '" + s.substr(0, 40) + "' is not a finite number within 1e30"));
+  return v;
+}
+
+// The bicubic_patch blocks of teapot.inc: each `{ ... }` closed and holding
+// exactly 16 vectors <x, y, z>; anything else named with its line (HOSTILE2
+// F43: 20 points, an unclosed brace and <1,2> were accepted).
 std::vector<Patch> read_teapot_inc(const std::string& file) {
   ra::check_input_file(file);  // /dev/zero, a FIFO or a directory named, not read
   std::ifstream in(file);
@@ -49,17 +80,34 @@ std::vector<Patch> read_teapot_inc(const std::string& file) {
   ss << in.rdbuf();
   const std::string text = ss.str();
   std::vector<Patch> patches;
-  const std::regex vec(R"(<\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*>)");
+  LineOf line_of{text};
   for (std::size_t at = text.find("bicubic_patch"); at != std::string::npos;
        at = text.find("bicubic_patch", at + 1)) {
-    const std::size_t end = text.find('}', at);
-    const std::string body = text.substr(at, end - at);
+    const long line = line_of(at);
+    const std::size_t open = text.find('{', at), close = text.find('}', at);
+    if (open == std::string::npos || close == std::string::npos || close < open)
+      throw ra::InputError(ra::located(file, line, "bicubic_patch without a closed { ... }"));
     Patch p;
     int k = 0;
-    for (auto it = std::sregex_iterator(body.begin(), body.end(), vec); it != std::sregex_iterator() && k < 16;
-         ++it, ++k)
-      p[k] = {std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3])};
-    if (k != 16) throw ra::InputError(ra::located(file, 0, "a bicubic_patch without 16 control points"));
+    for (std::size_t v = text.find('<', open); v != std::string::npos && v < close; v = text.find('<', v + 1)) {
+      const std::size_t e = text.find('>', v);
+      const long vline = line_of(v);
+      if (e == std::string::npos || e > close)
+        throw ra::InputError(ra::located(file, vline, "vector '<' without its '>'"));
+      const std::string body = text.substr(v + 1, e - v - 1);
+      std::vector<std::string> parts;
+      std::stringstream fields(body);
+      for (std::string f; std::getline(fields, f, ',');) parts.push_back(f);
+      if (parts.size() != 3)
+        throw ra::InputError(ra::located(file, vline, "vector with " + std::to_string(parts.size()) +
+                                                          " components (3 needed)"));
+      if (k < 16) p[k] = {inc_number(file, vline, parts[0]), inc_number(file, vline, parts[1]),
+                          inc_number(file, vline, parts[2])};
+      ++k;
+    }
+    if (k != 16)
+      throw ra::InputError(ra::located(file, line, "bicubic_patch with " + std::to_string(k) +
+                                                       " control points (16 needed)"));
     patches.push_back(p);
   }
   if (patches.empty()) throw ra::InputError(ra::located(file, 0, "no bicubic_patch found"));
@@ -80,9 +128,23 @@ Vec3d eval_patch(const Patch& p, double u, double v) {
   return {out.x, out.z, -out.y};  // z-up -> y-up
 }
 
+// About 400 bytes a triangle while tessellating (welding map, faces, text):
+// 1M triangles (the real teapot at --steps 128) stay in hundreds of MB.
+constexpr double kMaxTeapotTriangles = 1 << 20;
+
 void generate_teapot(const std::string& inc, const std::string& out_path, int steps) {
   ra::declare_output(out_path);
   const auto patches = read_teapot_inc(inc);
+  // The size of the work from the file and --steps, before it (HOSTILE2 F43:
+  // a 327 KB .inc at --steps 256 took 2.6 GB, a 32 MB one 16.8 GB).
+  const double triangles = 2.0 * double(patches.size()) * steps * steps;
+  if (triangles > kMaxTeapotTriangles)
+    throw ra::InputError(ra::located(inc, 0, std::to_string(patches.size()) + " patches at --steps " +
+                                                 std::to_string(steps) + " make " +
+                                                 std::to_string((long long)triangles) + " triangles (about " +
+                                                 std::to_string((long long)(triangles * 400 / 1e6)) +
+                                                 " MB); at most " + std::to_string((long long)kMaxTeapotTriangles) +
+                                                 ": a smaller --steps"));
   std::vector<Vec3d> positions;
   std::map<std::array<long long, 3>, int> weld;
   auto vertex = [&](const Vec3d& p) {

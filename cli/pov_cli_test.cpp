@@ -134,6 +134,22 @@ TEST(CompareCli, OneUnwritableOutputMeansNoOutputAtAll) {
   fs::remove_all(dir);
 }
 
+// An image output in a format compare cannot write is refused with the
+// other destination checks, before either render (HOSTILE2 F44: after both,
+// with the comparison already printed).
+TEST(CompareCli, UnsupportedImageFormatIsRefusedBeforeRendering) {
+  const fs::path dir = temp_dir("compare-format");
+  for (const char* flag : {"--diff", "--ours", "--pov"}) {
+    const auto r = ra::test::run_rayaudit("compare " + kSphereOnPlane + " --width 40 --height 30 --json " +
+                                          (dir / "c.json").string() + " " + flag + " " + (dir / "x.jpg").string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_EQ(r.err, (dir / "x.jpg").string() + ": unsupported output format (use .png or .exr)\n") << flag;
+    EXPECT_EQ(r.out, "") << flag << ": the comparison ran";
+    EXPECT_TRUE(fs::is_empty(dir)) << flag;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(ExportPovCli, OneUnwritableOutputMeansNoOutputAtAll) {
   const fs::path dir = temp_dir("export-half");
   const std::string textured = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/teapot-textured.json";
