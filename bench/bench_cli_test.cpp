@@ -185,6 +185,73 @@ TEST(BenchCli, OtherArgumentsAreRefused) {
   expect_refused("--threads 0", "--threads");
 }
 
+// Google Benchmark flags with bad values: one line naming the flag, exit 2,
+// before anything runs (HOSTILE2 F34: a negative count was "vector::reserve"
+// exit 1, an unknown format printed the usage text with exit 0).
+TEST(BenchCli, BadBenchmarkFlagValuesAreRefused) {
+  expect_refused("--benchmark_repetitions=-5", "--benchmark_repetitions: \"-5\" is not a whole number");
+  expect_refused("--benchmark_repetitions=abc", "--benchmark_repetitions: \"abc\"");
+  expect_refused("--benchmark_repetitions=100000000", "from 1 to 1000");
+  expect_refused("--benchmark_format=xml", "--benchmark_format: \"xml\" is not supported");
+  expect_refused("--benchmark_min_time=0x10", "--benchmark_min_time");
+  expect_refused("--benchmark_list_tests=maybe", "--benchmark_list_tests: \"maybe\" is not true or false");
+  expect_refused("--benchmark_bogus=1", "--benchmark_bogus: \"1\" is not a Google Benchmark flag");
+}
+
+// Listing runs nothing: with --json the old file stayed 0 bytes (HOSTILE2
+// F33); now refused and the old file untouched. Without --json it lists.
+TEST(BenchCli, ListTestsNeverTouchesTheJson) {
+  const fs::path out = temp_json("listed.json");
+  std::ofstream(out) << "PRECIOUS\n";
+  const auto r = run_rayaudit("bench --benchmark_list_tests=true --json " + out.string() +
+                              " --filter kernel/moller/float/nocull/hit=50/back=0");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--benchmark_list_tests"), std::string::npos) << r.err;
+  std::ifstream in(out);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "PRECIOUS\n");
+  const auto l = run_rayaudit("bench --benchmark_list_tests --filter kernel/moller/float/nocull/hit=50/back=0");
+  EXPECT_EQ(l.code, 0) << l.all;
+  EXPECT_NE(l.out.find("kernel/moller/float/nocull/hit=50/back=0"), std::string::npos) << l.out;
+}
+
+// --json naming a corpus mesh the run reads (HOSTILE2 F36: it was replaced).
+TEST(BenchCli, JsonThatIsACorpusInputIsRefused) {
+  const fs::path cache = fs::temp_directory_path() / ("rayaudit-bench-cache-" + std::to_string(::getpid()));
+  fs::create_directories(cache / "corpus" / "ladder");
+  const fs::path mesh = cache / "corpus" / "ladder" / "box.obj";
+  const std::string box = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(mesh) << box;
+  const auto r = run_rayaudit("bench --filter scene/box/none/nocull/primary/threads=1 --json " + mesh.string(),
+                              "RAYAUDIT_CACHE=" + cache.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("is also an input of this command"), std::string::npos) << r.err;
+  std::ifstream in(mesh);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, box);
+  fs::remove_all(cache);
+}
+
+// A full disk: exit 2 with one line, the old JSON kept (HOSTILE2 F35: exit
+// 0 and a truncated JSON in its place). Google Benchmark's JSON is held in
+// memory and written with every write checked.
+TEST(BenchCli, FullDiskKeepsTheOldJson) {
+  ra::test::FullDisk disk(2048);
+  if (!disk.ok()) GTEST_SKIP() << disk.why_not();
+  const fs::path out = disk.dir() / "b.json";
+  std::ofstream(out) << "PRECIOUS\n";
+  const auto r = run_rayaudit("bench --benchmark_repetitions=1 --benchmark_min_time=0.001 --json " + out.string() +
+                              " --filter 'kernel/(moller|watertight)/(float|double)/'");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(out.string() + ": cannot write"), std::string::npos) << r.err;
+  std::ifstream in(out);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "PRECIOUS\n");
+}
+
 }  // namespace
 
 // HOSTILE2 F33-F36: --benchmark_list_tests with --json replaced OUT with
@@ -192,7 +259,10 @@ TEST(BenchCli, OtherArgumentsAreRefused) {
 // (exit 1 or 0); --json could name a corpus mesh the rows read; on a full
 // disk the cut-short JSON replaced the previous file (checked in
 // ReliabilityCli's tmpfs tests' way only when root: here the refusals).
-TEST(BenchCli, ListTestsWithJsonBadPassThroughValuesAndCorpusOutputsAreRefused) {
+// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
+// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
+// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
+TEST(BenchCli, DISABLED_ListTestsWithJsonBadPassThroughValuesAndCorpusOutputsAreRefused) {
   const fs::path out = temp_json("keep.json");
   std::ofstream(out) << "PRECIOUS\n";
   const std::string row = " --filter 'kernel/moller/float/nocull/hit=50/back=0'";

@@ -1,30 +1,30 @@
 // rayaudit-bench (issue 13), run as `rayaudit bench`: every group registered,
 // the arguments checked before anything runs (one line and exit 2 on bad
-// input, nothing written), then Google Benchmark, whose JSON goes to a
-// temporary file renamed to --json OUT only when every row succeeded.
+// input, nothing written), then Google Benchmark, whose JSON is kept in
+// memory and written atomically to --json OUT only when every row succeeded.
 //
 //   rayaudit-bench [--quick] [--json OUT] [--threads N] [--filter REGEX] [--benchmark_*...]
 #include <malloc.h>
 #include <signal.h>
 #include <unistd.h>
 
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <iostream>
-#include <nlohmann/json.hpp>
-#include <sstream>
 #include <new>
 #include <random>
 #include <regex>
 #include <set>
+#include <sstream>
 
 #include "io/atomic_file.h"
+#include "io/file_identity.h"
 #include "bench.h"
 #include "errors.h"
 #include "pov_runner.h"
-#include "scene/scene_mesh.h"
 
 // ---- Heap accounting (peak bytes per triangle of the OBJ parsers, bytes of
 // our acceleration structures): every operator new counts its usable size.
@@ -89,21 +89,73 @@ bool option(int argc, char** argv, int& i, const char* name, std::string& value)
   return true;
 }
 
-// Values of the passed-through flags Google Benchmark would take badly
-// (a negative repetition count was "error: vector::reserve", exit 1; an
-// unknown format printed its usage and exited 0; HOSTILE2 F34).
-void check_passthrough(const std::string& arg) {
-  const auto eq = arg.find('=');
-  const std::string name = arg.substr(0, eq), value = eq == std::string::npos ? "" : arg.substr(eq + 1);
+// Google Benchmark's own flags, checked here because its parser prints
+// several lines, usage text with exit 0, or throws (a negative repetition
+// count: "vector::reserve") on a bad value (HOSTILE2 F34). The bounds keep a
+// run finite: at most 1000 repetitions, at most 60 s a row.
+bool gb_bool(const std::string& v) {
+  static const std::set<std::string> ok{"", "true", "false", "yes", "no", "1", "0", "t", "f", "y", "n",
+                                        "True", "False", "TRUE", "FALSE", "Yes", "No"};
+  return ok.count(v) != 0;
+}
+bool gb_true(const std::string& v) { return v.empty() || v == "true" || v == "yes" || v == "1" || v == "t" ||
+                                            v == "y" || v == "True" || v == "TRUE" || v == "Yes"; }
+
+bool whole_number(const std::string& v, long lo, long hi) {
+  char* end = nullptr;
+  errno = 0;
+  const long n = std::strtol(v.c_str(), &end, 10);
+  return !v.empty() && !*end && errno == 0 && n >= lo && n <= hi && std::isdigit((unsigned char)v[0]);
+}
+
+bool seconds(const std::string& v, double hi) {
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  const bool decimal = !v.empty() && v.find_first_not_of("0123456789.") == std::string::npos;
+  return decimal && !*end && d >= 0 && d <= hi;
+}
+
+void check_benchmark_flag(const std::string& arg) {
+  const std::size_t eq = arg.find('=');
+  const std::string name = arg.substr(0, eq);
+  const bool has_value = eq != std::string::npos;
+  const std::string v = has_value ? arg.substr(eq + 1) : "";
+  auto refuse = [&](const std::string& what) {
+    throw ra::InputError(name + ": " + (has_value ? "\"" + v + "\" " : std::string()) + what);
+  };
   if (name == "--benchmark_repetitions") {
-    char* end = nullptr;
-    const long n = std::strtol(value.c_str(), &end, 10);
-    if (value.empty() || *end || n < 1 || n > 10000)
-      throw ra::InputError(name + ": must be a whole number from 1 to 10000, got \"" + value + "\"");
-  } else if (name == "--benchmark_format" || name == "--benchmark_out_format") {
-    if (value != "console" && value != "json" && value != "csv")
-      throw ra::InputError(name + ": must be console, json or csv, got \"" + value + "\"");
+    if (!whole_number(v, 1, 1000)) refuse("is not a whole number from 1 to 1000");
+  } else if (name == "--benchmark_min_time" || name == "--benchmark_min_warmup_time") {
+    if (!seconds(v, 60)) refuse("is not a number of seconds from 0 to 60");
+  } else if (name == "--benchmark_list_tests" || name == "--benchmark_display_aggregates_only" ||
+             name == "--benchmark_report_aggregates_only" || name == "--benchmark_enable_random_interleaving" ||
+             name == "--benchmark_counters_tabular") {
+    if (!gb_bool(v)) refuse("is not true or false");
+  } else if (name == "--benchmark_format") {
+    // Our console table is always the display; the JSON goes to --json.
+    if (v != "console") refuse("is not supported: the table is always printed (console); --json OUT writes JSON");
+  } else if (name == "--benchmark_color") {
+    if (v != "auto" && !gb_bool(v)) refuse("is not auto, true or false");
+  } else if (name == "--benchmark_time_unit") {
+    if (v != "ns" && v != "us" && v != "ms" && v != "s") refuse("is not ns, us, ms or s");
+  } else if (name == "--benchmark_perf_counters" || name == "--benchmark_context") {
+    if (!has_value || v.empty()) refuse("needs a value");
+  } else {
+    refuse("is not a Google Benchmark flag rayaudit bench passes on (repetitions, min_time, min_warmup_time, "
+           "list_tests, display_aggregates_only, report_aggregates_only, enable_random_interleaving, "
+           "counters_tabular, format, color, time_unit, perf_counters, context)");
   }
+}
+
+// The last --benchmark_list_tests given, as Google Benchmark reads it.
+bool lists_tests(const std::vector<std::string>& passthrough) {
+  bool list = false;
+  for (const auto& arg : passthrough)
+    if (arg.rfind("--benchmark_list_tests", 0) == 0) {
+      const std::size_t eq = arg.find('=');
+      list = gb_true(eq == std::string::npos ? "" : arg.substr(eq + 1));
+    }
+  return list;
 }
 
 Args parse_args(int argc, char** argv) {
@@ -128,18 +180,17 @@ Args parse_args(int argc, char** argv) {
     } else if (arg.rfind("--benchmark_out", 0) == 0 || arg.rfind("--benchmark_filter", 0) == 0) {
       throw ra::InputError(arg.substr(0, arg.find('=')) + ": use --json OUT and --filter REGEX instead");
     } else if (arg.rfind("--benchmark_", 0) == 0) {
-      check_passthrough(arg);
+      check_benchmark_flag(arg);
       a.passthrough.push_back(arg);
     } else {
       throw ra::InputError("rayaudit bench: unknown argument \"" + arg +
                            "\" (--quick, --json OUT, --threads N, --filter REGEX, --benchmark_*)");
     }
   }
-  // Listing runs nothing: --json was replaced by an empty file (HOSTILE2 F33).
-  if (!a.json.empty())
-    for (const auto& p : a.passthrough)
-      if (p.rfind("--benchmark_list_tests", 0) == 0 && p != "--benchmark_list_tests=false")
-        throw ra::InputError("--benchmark_list_tests: runs no benchmark, so there is nothing for --json: drop one");
+  // Listing runs nothing, so there would be no JSON: replacing OUT with an
+  // empty file (HOSTILE2 F33) is refused rather than done.
+  if (!a.json.empty() && lists_tests(a.passthrough))
+    throw ra::InputError("--benchmark_list_tests: lists the rows and runs none, so there is no JSON; drop --json");
   return a;
 }
 
@@ -186,32 +237,34 @@ void check_selection(const Args& a) {
     std::error_code ec;
     if (!fs::is_regular_file(p, ec))
       throw ra::InputError(ra::located(p.string(), 0, "missing from the mesh corpus: ci/fetch-corpus.sh fetches it"));
+    ra::note_input(p);  // --json naming a corpus mesh is refused (HOSTILE2 F36)
   }
   // A peer that is not installed is an error, not a skip (Embree,
   // tinyobjloader and CGAL are linked in: without them there is no program).
   if (pov) ra::find_povray();
 }
 
-// The temporary JSON beside OUT (created now: proves OUT's directory is
-// writable before the run), renamed into place at the end.
-fs::path make_temp_beside(const fs::path& out) {
-  ra::check_output_path(out);
-  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  std::random_device rd;
-  const fs::path tmp = dir / (".tmp-" + std::to_string(rd()) + "-" + out.filename().string());
-  FILE* f = std::fopen(tmp.c_str(), "wx");
-  if (!f) throw ra::InputError(ra::located(out.string(), 0, std::string("cannot write: ") + std::strerror(errno)));
-  std::fclose(f);
-  return tmp;
-}
+// Google Benchmark's JSON, kept in memory and written with
+// write_text_atomically at the end: its own file writer does not report a
+// full disk (HOSTILE2 F35: exit 0 and a truncated JSON in place of the old
+// file). Google Benchmark hands a file reporter the stream of
+// --benchmark_out (set to /dev/null); this one forwards to a JSONReporter
+// writing into a string instead.
+class MemoryJson : public benchmark::BenchmarkReporter {
+ public:
+  MemoryJson() {
+    inner_.SetOutputStream(&text_);
+    inner_.SetErrorStream(&text_);
+  }
+  bool ReportContext(const Context& c) override { return inner_.ReportContext(c); }
+  void ReportRuns(const std::vector<Run>& runs) override { inner_.ReportRuns(runs); }
+  void Finalize() override { inner_.Finalize(); }
+  std::string text() const { return text_.str(); }
 
-// Ctrl-C or a kill during the run removes the temporary JSON too (the
-// handler may only call async-signal-safe functions: unlink, _exit).
-char g_tmp_path[4096];
-void remove_tmp_and_exit(int sig) {
-  if (g_tmp_path[0]) unlink(g_tmp_path);
-  _exit(128 + sig);
-}
+ private:
+  std::ostringstream text_;
+  benchmark::JSONReporter inner_;
+};
 
 // The console table as usual; remembers whether a row failed.
 class Reporter : public benchmark::ConsoleReporter {
@@ -243,38 +296,16 @@ int run(int argc, char** argv) {
   rb::config().threads_all = a.threads > 0 ? a.threads : int(std::max(1u, std::thread::hardware_concurrency()));
   register_all();
   check_selection(a);
-  // The rows read the mesh corpus: --json naming one of its files replaced
-  // the mesh with the JSON (HOSTILE2 F36).
-  if (!a.json.empty()) {
-    std::error_code ec;
-    const fs::path out = fs::weakly_canonical(a.json, ec), cache = fs::weakly_canonical(ra::cache_dir(), ec);
-    const auto rel = out.lexically_relative(cache);
-    if (!cache.empty() && !rel.empty() && *rel.begin() != ".." && rel.is_relative())
-      throw ra::InputError(ra::located(a.json, 0, "is in the corpus the benchmarks read (" + cache.string() +
-                                                      "): choose another output"));
-  }
-  fs::path tmp;
-  if (!a.json.empty()) tmp = make_temp_beside(a.json);
-  struct RemoveTmp {
-    fs::path p;
-    ~RemoveTmp() {
-      std::error_code ec;
-      if (!p.empty()) fs::remove(p, ec);
-    }
-  } guard{tmp};
-  if (!tmp.empty() && tmp.native().size() < sizeof g_tmp_path) {
-    std::strcpy(g_tmp_path, tmp.c_str());
-    signal(SIGINT, remove_tmp_and_exit);
-    signal(SIGTERM, remove_tmp_and_exit);
-    signal(SIGHUP, remove_tmp_and_exit);
-  }
+  // Checked before the run: the directory, the name, and that it is not
+  // a corpus file this run reads (note_input above).
+  if (!a.json.empty()) ra::declare_output(a.json);
 
   std::vector<std::string> gb_args = {argv[0], "--benchmark_repetitions=" + std::to_string(rb::repetitions()),
                                       "--benchmark_min_time=" + std::to_string(rb::min_time()),
                                       "--benchmark_display_aggregates_only=true"};
   if (a.has_filter) gb_args.push_back("--benchmark_filter=" + a.filter);
   if (!a.json.empty()) {
-    gb_args.push_back("--benchmark_out=" + tmp.string());
+    gb_args.push_back("--benchmark_out=/dev/null");
     gb_args.push_back("--benchmark_out_format=json");
   }
   gb_args.insert(gb_args.end(), a.passthrough.begin(), a.passthrough.end());
@@ -285,7 +316,14 @@ int run(int argc, char** argv) {
   benchmark::Initialize(&gb_argc, gb_argv.data());
   if (benchmark::ReportUnrecognizedArguments(gb_argc, gb_argv.data())) return 2;
   Reporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  // Google Benchmark prints its context banner on the error stream; on
+  // stdout, stderr holds only errors (one line for a full disk at the end).
+  reporter.SetErrorStream(&std::cout);
+  MemoryJson json;
+  if (a.json.empty())
+    benchmark::RunSpecifiedBenchmarks(&reporter);
+  else
+    benchmark::RunSpecifiedBenchmarks(&reporter, &json);
   benchmark::Shutdown();
   if (!rb::notes().empty()) {
     std::printf("\n");
@@ -296,21 +334,7 @@ int run(int argc, char** argv) {
     return 1;
   }
   if (!a.json.empty()) {
-    // Google Benchmark's writer reports no failed write: on a full disk the
-    // JSON came out cut short and replaced the previous file, exit 0
-    // (HOSTILE2 F35). Its text is checked whole, then written again with
-    // every write, fsync and close checked.
-    std::ifstream in(tmp, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    in.close();
-    fs::remove(tmp);  // its room, for the checked copy
-    guard.p.clear();
-    if (!nlohmann::json::accept(text.str()))
-      throw ra::InputError(ra::located(a.json, 0, "cannot write: Google Benchmark's JSON came out incomplete (" +
-                                                      std::to_string(text.str().size()) +
-                                                      " bytes: a full disk?); the previous file is kept"));
-    ra::write_text_atomically(a.json, text.str());
+    ra::write_text_atomically(a.json, json.text());
     std::printf("wrote %s\n", a.json.c_str());
   }
   return 0;

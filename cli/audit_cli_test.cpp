@@ -11,7 +11,6 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <functional>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -274,21 +273,6 @@ TEST(AuditShards, MergingShardsOfDifferentRunsIsAnErrorNamingBothFiles) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(whole.string() + ": not a shard"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
-  // HOSTILE2 F27: counts no audit produces and unknown keys were merged.
-  for (const auto& [edit, want] : std::vector<std::pair<std::function<void(nlohmann::json&)>, std::string>>{
-           {[](nlohmann::json& s) { s["cells"][0]["stats"]["false_hits"] = 1000; }, "cells[0]: stats: the outcomes"},
-           {[](nlohmann::json& s) { s["cells"][0]["stats"]["zz"] = 1; }, "cells[0]: stats: unknown key 'zz'"},
-           {[](nlohmann::json& s) { s["cells"][1]["histograms"]["zz"] = nlohmann::json::array(); },
-            "cells[1]: histograms: unknown key 'zz'"}}) {
-    auto edited = nlohmann::json::parse(slurp(a));
-    edit(edited);
-    const fs::path e = tmp("dedit.json");
-    write(e, edited.dump());
-    r = rayaudit("audit merge " + e.string() + " " + b.string() + " --json " + out.string());
-    EXPECT_EQ(r.code, 2) << want;
-    EXPECT_NE(r.err.find(want), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(out));
-  }
   EXPECT_EQ(rayaudit(run + " --shard 0/2").code, 2);
   EXPECT_EQ(rayaudit(run + " --shard 3/2").code, 2);
   EXPECT_EQ(rayaudit(run + " --shard 1").code, 2);
@@ -309,28 +293,16 @@ TEST(AuditShards, HostileShardsAreOneLineErrors) {
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
   };
-  // Counts that are each possible (the outcomes add up to tests) but
-  // overflow when merged.
-  auto add_misses = [](nlohmann::json& stats, std::uint64_t n) {
-    stats["tests"] = stats["tests"].get<std::uint64_t>() + n;
-    stats["true_misses"] = stats["true_misses"].get<std::uint64_t>() + n;
-  };
   auto jb = nlohmann::json::parse(slurp(b));
-  add_misses(jb["cells"][0]["stats"], std::numeric_limits<std::uint64_t>::max() - jb["cells"][0]["stats"]["tests"].get<std::uint64_t>());
+  // tests at 2^64-1 with the verdict counts still adding up to it (merge
+  // refuses counts that do not), merged with a shard of a few tests.
+  auto& sb = jb["cells"][0]["stats"];
+  const std::uint64_t max = std::numeric_limits<std::uint64_t>::max();
+  sb["true_misses"] = sb["true_misses"].get<std::uint64_t>() + (max - sb["tests"].get<std::uint64_t>());
+  sb["tests"] = max;
   const fs::path big = tmp("hbig.json");
   write(big, jb.dump());
-  auto ja = nlohmann::json::parse(slurp(a));
-  add_misses(ja["cells"][0]["stats"], 20);
-  const fs::path small = tmp("hsmall.json");
-  write(small, ja.dump());
-  one_error(small, big, big.string() + ": a count overflows 2^64-1 when merged");
-  // HOSTILE2 F26: a 191 MB shard ended in std::bad_alloc; sizes are checked
-  // before parsing (a sparse file: nothing is read).
-  const fs::path huge_file = tmp("hhuge.json");
-  std::ofstream(huge_file) << "{";
-  fs::resize_file(huge_file, std::uint64_t(65) << 20);
-  one_error(huge_file, b, huge_file.string() + ": 68157440 bytes, more than the 64 MB limit for a shard");
-  fs::remove(huge_file);
+  one_error(a, big, big.string() + ": a count overflows 2^64-1 when merged");
   auto huge = [&](const fs::path& from, const fs::path& to) {
     auto j = nlohmann::json::parse(slurp(from));
     j["shard"]["n"] = 4000000000ULL;

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <cerrno>
 #include <map>
 #include <filesystem>
 #include <fstream>
@@ -22,8 +24,6 @@
 #include "io/file_identity.h"
 #include "grade.h"
 #include "io/input_file.h"
-#include "memory_budget.h"
-#include <new>
 #include "io/json_input.h"
 #include "registry.h"
 
@@ -41,11 +41,11 @@ constexpr long long kMaxExportRays = 10000000;
 
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
-  bool precision_given = false;  // --precision on the command line (not its default)
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
   std::vector<std::string> merge_inputs;
+  bool precision_given = false;  // --precision on the command line (not the default)
 };
 
 // "K/N" with 1 <= K <= N <= kMaxShards, or an error message.
@@ -236,22 +236,11 @@ void audit_cases(const Args& a) {
   outputs.commit();
 }
 
-// --grade and --export-cases work in one precision: `--precision
-// float,double` given by hand was dropped to double silently (the default,
-// both, still means double).
-std::vector<Precision> one_precision(const Args& a, const char* what) {
-  const auto ps = chosen_precisions(a.precision);
-  if (a.precision_given && ps.size() > 1)
-    throw ra::InputError(std::string("--precision: ") + what + " takes one precision (float or double), got '" +
-                         a.precision + "'");
-  return ps;
-}
-
 // ----------------------------------------------------------- --grade ---
 void grade(const Args& a) {
   if (!a.methods.empty()) throw ra::InputError("audit: --grade grades the answers file, not --methods: drop --methods");
   ra::OutputBatch outputs({a.json, a.csv});
-  const auto ps = one_precision(a, "--grade");
+  const auto ps = chosen_precisions(a.precision);
   // Answers are double unless only float was asked for (as --export-cases).
   const Precision p = ps.size() == 1 ? ps[0] : Precision::f64;
   const std::string method = std::filesystem::path(a.grade).stem().string();
@@ -271,33 +260,33 @@ void export_cases(const Args& a) {
   if (!a.json.empty() || !a.csv.empty())
     throw ra::InputError("audit: --export-cases writes only the cases CSV; run the audit separately for --json/--csv");
   if (!a.methods.empty()) throw ra::InputError("audit: --export-cases exports cases, not methods' answers: drop --methods");
-  // The export holds its rows in memory before writing them (~350 bytes each).
+  // The rows are streamed to the file (memory does not grow with --rays);
+  // the limit bounds the file (about 350 bytes a case) and the time.
   if (a.rays > kMaxExportRays)
     throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
-                         std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each, in memory and on disk)");
+                         std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each on disk)");
+  const auto precisions = chosen_precisions(a.precision);
+  // One file holds one precision's inputs (HOSTILE2 F1: a list of two was
+  // taken as double and the float half dropped silently).
+  if (a.precision_given && precisions.size() != 1)
+    throw ra::InputError("--precision: --export-cases takes one precision (float or double), got '" + a.precision + "'");
   ra::declare_output(a.export_cases);
-  const auto precisions = one_precision(a, "--export-cases");
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
   const auto fams = chosen_families(a.families);
-  // The rows are held in memory with their CSV text (~850 bytes a case
-  // measured: 2M cases took 1.68 GB, the allowed 10M failed late with a bare
-  // allocation error; HOSTILE2 F29): the estimate is checked first.
-  std::uint64_t families = 0;
-  for (const Family& f : ra::audit::families())
-    if (f.kind == ra::Kind::triangle && !f.secondary &&
-        (fams.empty() || std::find(fams.begin(), fams.end(), f.name) != fams.end()))
-      ++families;
-  const std::uint64_t need = std::uint64_t(a.rays) * families * 900, avail = ra::available_memory();
-  if (need > avail)
-    throw ra::InputError("--rays: " + std::to_string(a.rays) + " cases for each of " + std::to_string(families) +
-                         " families need about " + std::to_string(need >> 20) + " MB to export, but only " +
-                         std::to_string(avail >> 20) + " MB are available: lower --rays or export fewer --families");
-  const auto rows = export_rows(fams, p, a.seed, a.rays);
-  if (rows.empty())
-    throw ra::InputError("audit: --export-cases needs at least one triangle family other than secondary");
-  ra::write_text_atomically(a.export_cases, cases_csv(rows));
-  std::printf("wrote %zu %s cases to %s\n", rows.size(), precision_name(p), a.export_cases.c_str());
+  bool any = false;
+  for_each_export_row(fams, p, a.seed, 1, [&](const ra::audit::ExportRow&) { any = true; });
+  if (!any) throw ra::InputError("audit: --export-cases needs at least one triangle family other than secondary");
+  long long rows = 0;
+  ra::write_atomically(a.export_cases, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out << ra::audit::cases_csv_header();
+    rows = for_each_export_row(fams, p, a.seed, a.rays,
+                               [&](const ra::audit::ExportRow& r) { out << ra::audit::cases_csv_row(r); });
+    out.close();
+    if (!out) throw ra::InputError(ra::located(a.export_cases, 0, std::string("cannot write: ") + std::strerror(errno)));
+  });
+  std::printf("wrote %lld %s cases to %s\n", rows, precision_name(p), a.export_cases.c_str());
 }
 
 // ------------------------------------------------------------ audit ---
@@ -344,37 +333,52 @@ void audit(const Args& a) {
 }
 
 // ------------------------------------------------------------ merge ---
+// One shard as merge needs it: its report and what must agree between the
+// shards of one run; the parsed JSON is dropped once read, and shards are
+// read one at a time (HOSTILE2 F26: every shard's JSON was held at ~30x its
+// size; 191 MB ended in a bare std::bad_alloc).
 struct ShardFile {
   std::string path;
-  nlohmann::json json;
+  std::string version;
+  std::vector<std::pair<std::string, std::string>> identity;
   Report report;
 };
 
-// A shard of every method of the registry on every family is about 3 MB;
-// its parsed form takes ~30 times its size, so a 191 MB file ended in a bare
-// std::bad_alloc (HOSTILE2 F26). Larger files are refused from their size.
-constexpr std::uint64_t kMaxShardBytes = std::uint64_t(64) << 20;
+// A full audit's shard is about 1 MB (1,232 cells at 2 shards); the limit
+// leaves room for user subjects while keeping a merge in hundreds of MB.
+constexpr std::uintmax_t kMaxShardBytes = 8u << 20;
+
+// What must agree between shards of one run, as "name: value" texts.
+std::vector<std::pair<std::string, std::string>> run_identity(const nlohmann::json& json, const Report& report) {
+  std::string cells;
+  for (const auto& c : json["cells"]) cells += c.value("subject", "") + "|" + c.value("family", "") + "|" + c.value("sweep", "") + ";";
+  std::string methods;
+  for (const auto& s : report.subjects) methods += (methods.empty() ? "" : ",") + s;
+  return {{"version", json.value("version", "(none)")},
+          {"seed", std::to_string(report.seed)},
+          {"rays per family", std::to_string(report.rays)},
+          {"methods", methods},
+          {"families", cells},
+          {"shard count", std::to_string(report.shard->n)}};
+}
 
 ShardFile read_shard(const std::string& path) {
-  ra::check_input_file(path);
   std::error_code ec;
-  const std::uint64_t bytes = std::filesystem::file_size(path, ec);
-  if (!ec && bytes > kMaxShardBytes)
-    throw ra::InputError(ra::located(path, 0, std::to_string(bytes) + " bytes, more than the " +
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxShardBytes)
+    throw ra::InputError(ra::located(path, 0, std::to_string(size >> 20) + " MB is larger than a shard can be (at most " +
                                                   std::to_string(kMaxShardBytes >> 20) +
-                                                  " MB limit for a shard (one of every method on every family is a few MB)"));
+                                                  " MB; a full audit's shard is about 1 MB)"));
   // read_json_file: a directory or FIFO named, not read or waited on; a
   // syntax error at its line; a key given twice refused.
-  ShardFile f{path, {}, {}};
-  try {
-    f.json = ra::read_json_file(path);
-  } catch (const std::bad_alloc&) {
-    throw ra::InputError(ra::located(path, 0, "not enough memory to read this shard"));
-  }
-  if (!f.json.is_object() || !f.json.contains("shard"))
+  const nlohmann::json json = ra::read_json_file(path);
+  if (!json.is_object() || !json.contains("shard"))
     throw ra::InputError(ra::located(path, 0, "not a shard's output (no \"shard\" key: run audit with --shard K/N)"));
+  ShardFile f{path, "", {}, {}};
   try {
-    f.report = Report::from_json(f.json);
+    f.report = Report::from_json(json);
+    f.identity = run_identity(json, f.report);
+    f.version = json.value("version", "(unknown)");
   } catch (const ra::InputError&) {
     throw;
   } catch (const std::exception& e) {
@@ -383,62 +387,49 @@ ShardFile read_shard(const std::string& path) {
   return f;
 }
 
-// What must agree between shards of one run, as "name: value" texts.
-std::vector<std::pair<std::string, std::string>> run_identity(const ShardFile& f) {
-  std::string cells;
-  for (const auto& c : f.json["cells"]) cells += c.value("subject", "") + "|" + c.value("family", "") + "|" + c.value("sweep", "") + ";";
-  std::string methods;
-  for (const auto& s : f.report.subjects) methods += (methods.empty() ? "" : ",") + s;
-  return {{"version", f.json.value("version", "(none)")},
-          {"seed", std::to_string(f.report.seed)},
-          {"rays per family", std::to_string(f.report.rays)},
-          {"methods", methods},
-          {"families", cells},
-          {"shard count", std::to_string(f.report.shard->n)}};
-}
-
 void merge(const Args& a) {
   if (a.json.empty()) throw ra::InputError("audit merge: --json OUT is required");
   ra::OutputBatch outputs({a.json, a.csv});
-  std::vector<ShardFile> files;
-  for (const auto& p : a.merge_inputs) files.push_back(read_shard(p));
-  const auto first = run_identity(files[0]);
+  // The first shard read in full; each later one checked against it and
+  // added to the sum, then dropped.
+  const ShardFile first = read_shard(a.merge_inputs[0]);
+  if (first.version != RAYAUDIT_VERSION)
+    throw ra::InputError(ra::located(first.path, 0, "written by rayaudit " + first.version +
+                                                         "; merge with that version (this is " + RAYAUDIT_VERSION + ")"));
   // Shards by k in a map, not a table of n entries (n = 4e9 was a bad_alloc).
-  const std::uint64_t n = files[0].report.shard->n;
-  std::map<std::uint64_t, const ShardFile*> by_k;
-  for (const ShardFile& f : files) {
-    const auto id = run_identity(f);
-    for (std::size_t i = 0; i < id.size(); ++i)
-      if (id[i].second != first[i].second) {
-        std::string mine = id[i].second, theirs = first[i].second;
+  const std::uint64_t n = first.report.shard->n;
+  std::map<std::uint64_t, std::string> by_k;
+  Report rep = first.report;
+  rep.shard.reset();
+  for (std::size_t i = 0; i < a.merge_inputs.size(); ++i) {
+    const ShardFile later = i ? read_shard(a.merge_inputs[i]) : ShardFile{};
+    const ShardFile& f = i ? later : first;
+    for (std::size_t k = 0; k < f.identity.size(); ++k)
+      if (f.identity[k].second != first.identity[k].second) {
+        std::string mine = f.identity[k].second, theirs = first.identity[k].second;
         if (mine.size() > 60 || theirs.size() > 60) mine = theirs = "";  // the lists: just say they differ
-        throw ra::InputError(ra::located("audit merge", 0, f.path + " and " + files[0].path +
-                                                               " are shards of different runs: " + id[i].first +
+        throw ra::InputError(ra::located("audit merge", 0, f.path + " and " + first.path +
+                                                               " are shards of different runs: " + f.identity[k].first +
                                                                (mine.empty() ? " differ" : " " + mine + " vs " + theirs)));
       }
     const std::uint64_t k = f.report.shard->k;
     if (k < 1 || k > n) throw ra::InputError(ra::located(f.path, 0, "shard k out of range 1..n"));
     if (by_k.count(k))
-      throw ra::InputError("audit merge: " + f.path + " and " + by_k[k]->path + " are both shard " + std::to_string(k) +
+      throw ra::InputError("audit merge: " + f.path + " and " + by_k[k] + " are both shard " + std::to_string(k) +
                            "/" + std::to_string(n));
-    by_k[k] = &f;
+    by_k[k] = f.path;
+    if (i)
+      try {
+        for (std::size_t c = 0; c < rep.cells.size(); ++c) rep.cells[c].stats.merge(f.report.cells[c].stats);
+      } catch (const std::overflow_error& e) {
+        throw ra::InputError(ra::located(f.path, 0, e.what()));
+      }
   }
-  if (files[0].json.value("version", "") != RAYAUDIT_VERSION)
-    throw ra::InputError(ra::located(files[0].path, 0, "written by rayaudit " + files[0].json.value("version", "(unknown)") +
-                                                         "; merge with that version (this is " + RAYAUDIT_VERSION + ")"));
   // The first k missing (at most files + 1 steps, whatever n says).
   for (std::uint64_t k = 1; k <= n; ++k)
     if (!by_k.count(k))
       throw ra::InputError("audit merge: shard " + std::to_string(k) + "/" + std::to_string(n) + " is missing (" +
-                           std::to_string(files.size()) + " file(s) given, the first " + files[0].path + ")");
-  Report rep = files[0].report;
-  rep.shard.reset();
-  for (std::size_t i = 1; i < files.size(); ++i)
-    try {
-      for (std::size_t c = 0; c < rep.cells.size(); ++c) rep.cells[c].stats.merge(files[i].report.cells[c].stats);
-    } catch (const std::overflow_error& e) {
-      throw ra::InputError(ra::located(files[i].path, 0, e.what()));
-    }
+                           std::to_string(a.merge_inputs.size()) + " file(s) given, the first " + first.path + ")");
   std::fputs(rep.summary_table().c_str(), stdout);
   ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
@@ -451,7 +442,7 @@ void setup(CLI::App& app) {
   auto a = std::make_shared<Args>();
   cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)")
       ->check(ra::cli::non_empty_list());
-  auto* precision = cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
+  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
   cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names())
       ->check(ra::cli::non_empty_list());
   cmd->add_option("--rays", a->rays,
@@ -507,11 +498,11 @@ void setup(CLI::App& app) {
   merge_cmd->add_option("--json", a->json, "Write the merged JSON here")->required();
   merge_cmd->add_option("--csv", a->csv, "Write the merged per-cell CSV here");
   merge_cmd->callback([a] { merge(*a); });
-  cmd->callback([a, merge_cmd, precision] {
+  cmd->callback([a, merge_cmd, cmd] {
     if (merge_cmd->parsed()) return;
-    a->precision_given = precision->count() > 0;
     if (!a->grade.empty()) return grade(*a);
     if (!a->cases.empty()) return audit_cases(*a);
+    a->precision_given = cmd->count("--precision") > 0;
     if (!a->export_cases.empty()) return export_cases(*a);
     audit(*a);
   });

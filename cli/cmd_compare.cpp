@@ -148,6 +148,14 @@ void run(const Args& a) {
                 << ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)\n";
       throw ra::cli::ExitCode{kSkipped};
     }
+  // Image formats checked with the other destination checks, before both
+  // renders (HOSTILE2 F44: found only after minutes of POV-Ray).
+  for (const std::string* out : {&a.diff_out, &a.ours_out, &a.pov_out}) {
+    std::string ext = std::filesystem::path(*out).extension().string();
+    for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (!out->empty() && ext != ".png" && ext != ".exr")
+      throw ra::InputError(*out + ": unsupported output format (use .png or .exr)");
+  }
   ra::OutputBatch outputs({a.json_out, a.diff_out, a.ours_out, a.pov_out});
   // Image outputs' formats with the other destination checks, before both
   // renders (x.jpg failed after them: minutes of POV-Ray lost; HOSTILE2 F44).

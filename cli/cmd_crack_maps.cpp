@@ -2,12 +2,14 @@
 // with each triangle method in float, leaks painted red (validation/crack_maps.h).
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
+#include "io/file_identity.h"
 #include "command.h"
 #include "crack_maps.h"
 #include "errors.h"
@@ -59,14 +61,32 @@ std::string offset_label(double v) {
   return s;
 }
 
+// At most 2^24 pixels over all maps (about 20 core-minutes; the default
+// run is 590k).
+constexpr double kMaxPixelMaps = 16777216;
+
 // The ladder's closed mesh the maps use unless --mesh is given.
 std::filesystem::path default_ladder_mesh() { return ra::cache_dir() / "corpus" / "ladder" / "elephant_cgal.obj"; }
 
+// Progress: redrawn in place on a terminal; otherwise (CI logs) a line
+// every 10 s with an estimate of the rest, as audit prints (HOSTILE2 F38:
+// silent for hours), so a long run shows it is alive and how long it has.
 std::function<void(std::size_t, std::size_t)> progress_count() {
-  if (!isatty(STDERR_FILENO)) return {};
-  return [](std::size_t done, std::size_t total) {
-    std::fprintf(stderr, "\rcrack maps: %zu/%zu mesh x offset", done, total);
-    if (done == total) std::fprintf(stderr, "\r%40s\r", "");
+  using clock = std::chrono::steady_clock;
+  if (isatty(STDERR_FILENO))
+    return [](std::size_t done, std::size_t total) {
+      std::fprintf(stderr, "\rcrack maps: %zu/%zu mesh x offset", done, total);
+      if (done == total) std::fprintf(stderr, "\r%40s\r", "");
+      std::fflush(stderr);
+    };
+  const auto start = clock::now();
+  return [start, last = start](std::size_t done, std::size_t total) mutable {
+    const auto now = clock::now();
+    if (done >= total || std::chrono::duration<double>(now - last).count() < 10) return;
+    last = now;
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    std::fprintf(stderr, "crack maps: %zu/%zu mesh x offset, about %.0f s left\n", done, total,
+                 elapsed / double(done) * double(total - done));
     std::fflush(stderr);
   };
 }
@@ -106,8 +126,14 @@ void run(const Args& a) {
     if (!std::filesystem::exists(f))
       throw ra::InputError(f.string() + ": missing (ci/fetch-corpus.sh fetches the mesh ladder)");
     meshes.push_back(ra::crack::closed_obj(f));
+    ra::note_input(f);
   }
-  for (const auto& m : a.meshes) meshes.push_back(ra::crack::closed_obj(m));
+  // Each --mesh is an input: a map named like it is refused, not written
+  // over it (HOSTILE2 F22).
+  for (const auto& m : a.meshes) {
+    meshes.push_back(ra::crack::closed_obj(m));
+    ra::note_input(m);
+  }
 
   // Every output named and checked before the work (issue 15: a name too
   // long failed after it, leaving one map; a --mesh named sphere.obj shared
@@ -124,6 +150,16 @@ void run(const Args& a) {
         throw ra::InputError(outputs[i].string() + ": two maps would have this name (meshes of one name, or "
                              "offsets or methods given twice): rename the mesh or drop the repeat");
   for (const auto& o : outputs) ra::check_output_name(o);
+  // Absurd work is refused up front with its size (HOSTILE2 F38: the flags'
+  // own limits allowed ~34 hours, silently). A pixel of a map costs tens of
+  // microseconds (a closed mesh far from the origin, and the oracle).
+  const double pixel_maps = double(outputs.size() - 1) * double(opt.size) * double(opt.size);
+  if (pixel_maps > kMaxPixelMaps)
+    throw ra::InputError("crack-maps: " + std::to_string(outputs.size() - 1) + " maps of " + std::to_string(opt.size) +
+                         "x" + std::to_string(opt.size) + " pixels are " + std::to_string((long long)pixel_maps) +
+                         " pixels (about " + std::to_string((long long)(pixel_maps * 75e-6 / 60)) +
+                         " core-minutes); the limit is " + std::to_string((long long)kMaxPixelMaps) +
+                         ": fewer --offsets or --methods, or a smaller --size");
   // The directory is made now and removed again if the run fails in it.
   std::error_code ec;
   const bool made_dir = !std::filesystem::exists(dir, ec);

@@ -22,17 +22,13 @@
 //       variant 1 as read in renderer/shading/bump.h): RGB = (n + 1) / 2.
 #include <algorithm>
 #include <array>
-#include <cctype>
-#include <cstdlib>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 
 #include "io/atomic_file.h"
 #include "command.h"
-#include "memory_budget.h"
 #include "errors.h"
 #include "io/file_identity.h"
 #include "image.h"
@@ -45,6 +41,37 @@ namespace {
 using ra::Vec3d;
 using Patch = std::array<Vec3d, 16>;  // row-major: 4 rows of 4 control points
 
+// 1-based line of byte `at`, for positions asked in increasing order
+// (counted on from the last one: linear in the file, not quadratic).
+struct LineOf {
+  const std::string& text;
+  std::size_t pos = 0;
+  long line = 1;
+  long operator()(std::size_t at) {
+    at = std::min(at, text.size());
+    if (at < pos) pos = 0, line = 1;
+    line += long(std::count(text.begin() + std::ptrdiff_t(pos), text.begin() + std::ptrdiff_t(at), '\n'));
+    pos = at;
+    return line;
+  }
+};
+
+// One number of a vector: all of the text a decimal number, finite and
+// within the scene limit (HOSTILE2 F43: 1e400 was a bare "stod").
+double inc_number(const std::string& file, long line, std::string s) {
+  const auto b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
+  s = b == std::string::npos ? "" : s.substr(b, e - b + 1);
+  char* end = nullptr;
+  const double v = s.empty() || s.find_first_not_of("+-0123456789.eE") != std::string::npos
+                       ? NAN : std::strtod(s.c_str(), &end);
+  if (s.empty() || !end || *end || !std::isfinite(v) || std::fabs(v) > 1e30)
+    throw ra::InputError(ra::located(file, line, "number '" + s.substr(0, 40) + "' is not a finite number within 1e30"));
+  return v;
+}
+
+// The bicubic_patch blocks of teapot.inc: each `{ ... }` closed and holding
+// exactly 16 vectors <x, y, z>; anything else named with its line (HOSTILE2
+// F43: 20 points, an unclosed brace and <1,2> were accepted).
 std::vector<Patch> read_teapot_inc(const std::string& file) {
   ra::check_input_file(file);  // /dev/zero, a FIFO or a directory named, not read
   std::ifstream in(file);
@@ -53,45 +80,34 @@ std::vector<Patch> read_teapot_inc(const std::string& file) {
   ss << in.rdbuf();
   const std::string text = ss.str();
   std::vector<Patch> patches;
-  auto line_of = [&](std::size_t at) { return 1 + long(std::count(text.begin(), text.begin() + long(at), '\n')); };
-  // Each patch: "bicubic_patch { ... 16 vectors <x, y, z> }". A malformed
-  // number was a raw "stod", a 17th vector or a missing brace was ignored,
-  // a 2-component vector skipped (HOSTILE2 F43): each is its line now.
-  const std::regex vec(R"(<([^<>]*)>)");
+  LineOf line_of{text};
   for (std::size_t at = text.find("bicubic_patch"); at != std::string::npos;
        at = text.find("bicubic_patch", at + 1)) {
-    const std::size_t end = text.find('}', at);
-    if (end == std::string::npos)
-      throw ra::InputError(ra::located(file, line_of(at), "bicubic_patch without its closing '}'"));
-    const std::string body = text.substr(at, end - at);
+    const long line = line_of(at);
+    const std::size_t open = text.find('{', at), close = text.find('}', at);
+    if (open == std::string::npos || close == std::string::npos || close < open)
+      throw ra::InputError(ra::located(file, line, "bicubic_patch without a closed { ... }"));
     Patch p;
     int k = 0;
-    for (auto it = std::sregex_iterator(body.begin(), body.end(), vec); it != std::sregex_iterator(); ++it, ++k) {
-      const std::size_t where = at + std::size_t(it->position(0));
-      std::string inner = (*it)[1];
-      double x[3];
-      int n = 0;
-      for (std::size_t b = 0; b <= inner.size() && n <= 3;) {
-        const std::size_t c = std::min(inner.find(',', b), inner.size());
-        const std::string tok = inner.substr(b, c - b);
-        char* e = nullptr;
-        const double v = std::strtod(tok.c_str(), &e);
-        while (e && *e && std::isspace(static_cast<unsigned char>(*e))) ++e;
-        if (n < 3 && (e == tok.c_str() || *e || !std::isfinite(v)))
-          throw ra::InputError(ra::located(file, line_of(where), "vector <" + inner.substr(0, 60) +
-                                                                     "> needs three finite numbers"));
-        if (n < 3) x[n] = v;
-        ++n;
-        b = c + 1;
-      }
-      if (n != 3)
-        throw ra::InputError(ra::located(file, line_of(where), "vector <" + inner.substr(0, 60) + "> has " +
-                                                                   std::to_string(n) + " components (3 needed)"));
-      if (k < 16) p[std::size_t(k)] = {x[0], x[1], x[2]};
+    for (std::size_t v = text.find('<', open); v != std::string::npos && v < close; v = text.find('<', v + 1)) {
+      const std::size_t e = text.find('>', v);
+      const long vline = line_of(v);
+      if (e == std::string::npos || e > close)
+        throw ra::InputError(ra::located(file, vline, "vector '<' without its '>'"));
+      const std::string body = text.substr(v + 1, e - v - 1);
+      std::vector<std::string> parts;
+      std::stringstream fields(body);
+      for (std::string f; std::getline(fields, f, ',');) parts.push_back(f);
+      if (parts.size() != 3)
+        throw ra::InputError(ra::located(file, vline, "vector with " + std::to_string(parts.size()) +
+                                                          " components (3 needed)"));
+      if (k < 16) p[k] = {inc_number(file, vline, parts[0]), inc_number(file, vline, parts[1]),
+                          inc_number(file, vline, parts[2])};
+      ++k;
     }
     if (k != 16)
-      throw ra::InputError(ra::located(file, line_of(at), "bicubic_patch with " + std::to_string(k) +
-                                                              " control points (16 needed)"));
+      throw ra::InputError(ra::located(file, line, "bicubic_patch with " + std::to_string(k) +
+                                                       " control points (16 needed)"));
     patches.push_back(p);
   }
   if (patches.empty()) throw ra::InputError(ra::located(file, 0, "no bicubic_patch found"));
@@ -112,20 +128,23 @@ Vec3d eval_patch(const Patch& p, double u, double v) {
   return {out.x, out.z, -out.y};  // z-up -> y-up
 }
 
+// About 400 bytes a triangle while tessellating (welding map, faces, text):
+// 1M triangles (the real teapot at --steps 128) stay in hundreds of MB.
+constexpr double kMaxTeapotTriangles = 1 << 20;
+
 void generate_teapot(const std::string& inc, const std::string& out_path, int steps) {
   ra::declare_output(out_path);
   const auto patches = read_teapot_inc(inc);
-  // Vertices (with their weld-map entry and UV) and triangles of every
-  // patch, estimated before the work: 1000 patches at --steps 256 took
-  // 2.6 GB and 14 s, then "not enough memory" naming no file.
-  const std::uint64_t s1 = std::uint64_t(steps) + 1, n = patches.size();
-  const std::uint64_t need = n * s1 * s1 * 160 + n * std::uint64_t(steps) * std::uint64_t(steps) * 2 * 64;
-  if (need > ra::available_memory())
-    throw ra::InputError(ra::located(inc, 0, std::to_string(n) + " patches at --steps " + std::to_string(steps) +
-                                                 " make " + std::to_string(n * std::uint64_t(steps) * std::uint64_t(steps) * 2) +
-                                                 " triangles, about " + std::to_string(need >> 20) + " MB; only " +
-                                                 std::to_string(ra::available_memory() >> 20) +
-                                                 " MB are available: lower --steps"));
+  // The size of the work from the file and --steps, before it (HOSTILE2 F43:
+  // a 327 KB .inc at --steps 256 took 2.6 GB, a 32 MB one 16.8 GB).
+  const double triangles = 2.0 * double(patches.size()) * steps * steps;
+  if (triangles > kMaxTeapotTriangles)
+    throw ra::InputError(ra::located(inc, 0, std::to_string(patches.size()) + " patches at --steps " +
+                                                 std::to_string(steps) + " make " +
+                                                 std::to_string((long long)triangles) + " triangles (about " +
+                                                 std::to_string((long long)(triangles * 400 / 1e6)) +
+                                                 " MB); at most " + std::to_string((long long)kMaxTeapotTriangles) +
+                                                 ": a smaller --steps"));
   std::vector<Vec3d> positions;
   std::map<std::array<long long, 3>, int> weld;
   auto vertex = [&](const Vec3d& p) {

@@ -134,6 +134,22 @@ TEST(CompareCli, OneUnwritableOutputMeansNoOutputAtAll) {
   fs::remove_all(dir);
 }
 
+// An image output in a format compare cannot write is refused with the
+// other destination checks, before either render (HOSTILE2 F44: after both,
+// with the comparison already printed).
+TEST(CompareCli, UnsupportedImageFormatIsRefusedBeforeRendering) {
+  const fs::path dir = temp_dir("compare-format");
+  for (const char* flag : {"--diff", "--ours", "--pov"}) {
+    const auto r = ra::test::run_rayaudit("compare " + kSphereOnPlane + " --width 40 --height 30 --json " +
+                                          (dir / "c.json").string() + " " + flag + " " + (dir / "x.jpg").string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_EQ(r.err, (dir / "x.jpg").string() + ": unsupported output format (use .png or .exr)\n") << flag;
+    EXPECT_EQ(r.out, "") << flag << ": the comparison ran";
+    EXPECT_TRUE(fs::is_empty(dir)) << flag;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(ExportPovCli, OneUnwritableOutputMeansNoOutputAtAll) {
   const fs::path dir = temp_dir("export-half");
   const std::string textured = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/teapot-textured.json";
@@ -270,7 +286,10 @@ namespace {
 // HOSTILE2 F30: SIGTERM to compare while POV-Ray renders left POV-Ray
 // running as an orphan and its working directory in /tmp. The signal is
 // forwarded, waited for, and the directory removed; exit 2, one line.
-TEST(CompareCli, SigtermWhilePovRayRendersStopsItAndRemovesItsDirectory) {
+// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
+// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
+// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
+TEST(CompareCli, DISABLED_SigtermWhilePovRayRendersStopsItAndRemovesItsDirectory) {
   const fs::path d = temp_dir("sigterm");
   const std::string script =
       std::string(RAYAUDIT_EXE) + " compare " + RAYAUDIT_SOURCE_DIR + "/scenes/doc002-tetrahedron.json" +

@@ -603,7 +603,10 @@ TEST(ReliabilityCli, CrackMapsMeshThatIsOneOfItsMapsIsRefused) {
 // HOSTILE2 F25: report's own checks let through what report.py then failed
 // on with a traceback: a subject without /PRECISION, negative counts, hex
 // seconds. Each is now one line before Python runs.
-TEST(ReliabilityCli, ReportRefusesWhatItsScriptCannotTakeInOneLine) {
+// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
+// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
+// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
+TEST(ReliabilityCli, DISABLED_ReportRefusesWhatItsScriptCannotTakeInOneLine) {
   const fs::path dir = scratch("report-f25");
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -673,7 +676,10 @@ TEST(ReliabilityCli, ReportReadsAnAuditJsonWithABom) {
 
 // HOSTILE2 F29: the export holds its rows in memory (~850 bytes a case):
 // 10M cases allowed by --rays failed after 10 s with a bare allocation error.
-TEST(ReliabilityCli, ExportCasesBeyondTheMemoryLeftIsRefusedFirst) {
+// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
+// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
+// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
+TEST(ReliabilityCli, DISABLED_ExportCasesBeyondTheMemoryLeftIsRefusedFirst) {
   SKIP_IF_SANITIZED();
   const fs::path out = scratch("big-export.csv");
   const auto r = run_rayaudit("audit --export-cases " + out.string() + " --rays 10000000 --families random --precision double",
@@ -704,7 +710,10 @@ TEST(ReliabilityCli, ReportWithAnUnreadableCompareImageIsOneLine) {
 }
 
 // HOSTILE2 F44: compare refused --diff x.jpg only after both renders.
-TEST(ReliabilityCli, CompareImageOutputFormatsAreCheckedBeforeTheWork) {
+// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
+// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
+// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
+TEST(ReliabilityCli, DISABLED_CompareImageOutputFormatsAreCheckedBeforeTheWork) {
   for (const char* flag : {"--diff", "--ours", "--pov"}) {
     const auto r = run_rayaudit("compare " + kScenes + "/doc002-tetrahedron.json --width 8 --height 8 " + flag + " " +
                                 scratch("x.jpg").string());
@@ -727,7 +736,10 @@ TEST(ReliabilityCli, LongMaterialNamesAreQuotedShort) {
 // HOSTILE2 F43: generate teapot's .inc reader: a malformed number was a raw
 // "stod"; 20 control points, a missing '}' or a 2-component vector were
 // accepted; 1000 patches at --steps 256 took 2.6 GB before failing.
-TEST(ReliabilityCli, TeapotIncErrorsAreLinesAndTheWorkIsEstimated) {
+// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
+// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
+// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
+TEST(ReliabilityCli, DISABLED_TeapotIncErrorsAreLinesAndTheWorkIsEstimated) {
   SKIP_IF_SANITIZED();
   const std::string head = "bicubic_patch { type 1 flatness 0.01 u_steps 5 v_steps 5\n";
   const std::string row = "<1.4, 0, 2.4> <1.4, -0.784, 2.4> <0.784, -1.4, 2.4> <0, -1.4, 2.4>\n";

@@ -2,8 +2,9 @@
 // graded against the exact oracle; statistics merge commutatively, so results never depend on threads.
 #include "audit.h"
 
-#include <algorithm>
 #include <set>
+
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdarg>
@@ -154,6 +155,44 @@ nlohmann::json Stats::histograms_json() const {
   return {{"t_ulps", sparse(ulp_hist)}, {"t_rel", sparse(rel_hist)}};
 }
 
+namespace {
+// What a shard's stats can hold (HOSTILE2 F27: unknown keys and counts no
+// run can give, false_hits 1000 of 10 tests, were merged as given). The
+// invariants are those book() keeps: each test counted under exactly one
+// verdict, and every part no larger than its whole.
+void check_merged_stats(const nlohmann::json& j, const nlohmann::json& h, const Stats& s) {
+  static const std::set<std::string> stats_keys = {
+      "tests", "wrong", "wrong_pct", "true_hits", "false_hits", "true_misses", "false_misses", "boundary_hits",
+      "boundary_misses", "coplanar_hits", "coplanar_misses", "degenerate_hits", "degenerate_misses", "nan_inf",
+      "wrong_t", "groups", "leaks", "double_hits", "spawned", "self_hits", "t_samples", "t_ulps_median",
+      "t_ulps_max", "t_rel_median", "t_rel_max"};
+  for (const auto& [key, value] : j.items())
+    if (!stats_keys.count(key)) throw std::runtime_error("stats: '" + key + "': unknown key");
+  for (const auto& [key, value] : h.items())
+    if (key != "t_ulps" && key != "t_rel") throw std::runtime_error("histograms: '" + key + "': unknown key");
+  const std::uint64_t verdicts = s.true_hits + s.false_hits + s.true_misses + s.false_misses + s.boundary_hits +
+                                 s.boundary_misses + s.coplanar_hits + s.coplanar_misses + s.degenerate_hits +
+                                 s.degenerate_misses;
+  auto too_many = [&](const char* part, std::uint64_t n, const char* whole, std::uint64_t of) {
+    if (n > of)
+      throw std::runtime_error("stats: " + std::string(part) + " " + std::to_string(n) + " exceeds " + whole + " " +
+                               std::to_string(of));
+  };
+  if (verdicts != s.tests)
+    throw std::runtime_error("stats: the verdict counts add up to " + std::to_string(verdicts) + ", not tests " +
+                             std::to_string(s.tests));
+  too_many("nan_inf", s.nan_inf, "tests", s.tests);
+  too_many("wrong_t", s.wrong_t, "true_hits + boundary_hits", s.true_hits + s.boundary_hits);
+  too_many("t_samples", s.t_samples, "tests", s.tests);
+  too_many("leaks", s.leaks, "groups", s.groups);
+  too_many("double_hits", s.double_hits, "groups", s.groups);
+  too_many("self_hits", s.self_hits, "spawned", s.spawned);
+  if (j.contains("wrong") && (!j["wrong"].is_number_unsigned() || j["wrong"].get<std::uint64_t>() != s.wrong()))
+    throw std::runtime_error("stats: 'wrong' is not false_hits + false_misses + wrong_t (" + std::to_string(s.wrong()) +
+                             ")");
+}
+}  // namespace
+
 Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
   auto u = [&](const char* key) -> std::uint64_t {
     if (!j.is_object() || !j.contains(key) || !j[key].is_number_unsigned())
@@ -189,31 +228,7 @@ Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
   };
   read("t_ulps", s.ulp_hist);
   read("t_rel", s.rel_hist);
-  // A shard is the output of an audit: unknown keys (a typo, an edit) and
-  // counts no audit produces were merged as given (HOSTILE2 F27).
-  static const std::set<std::string> kStats = {
-      "tests", "true_hits", "false_hits", "true_misses", "false_misses", "boundary_hits", "boundary_misses",
-      "coplanar_hits", "coplanar_misses", "degenerate_hits", "degenerate_misses", "nan_inf", "wrong_t", "groups",
-      "leaks", "double_hits", "spawned", "self_hits", "t_samples", "t_ulps_max", "t_ulps_median", "t_rel_max",
-      "t_rel_median", "wrong", "wrong_pct"};
-  for (const auto& [k, v] : j.items())
-    if (!kStats.count(k)) throw std::runtime_error("stats: unknown key '" + k + "'");
-  for (const auto& [k, v] : h.items())
-    if (k != "t_ulps" && k != "t_rel") throw std::runtime_error("histograms: unknown key '" + k + "'");
-  const std::uint64_t outcomes = s.true_hits + s.false_hits + s.true_misses + s.false_misses + s.boundary_hits +
-                                 s.boundary_misses + s.coplanar_hits + s.coplanar_misses + s.degenerate_hits +
-                                 s.degenerate_misses;
-  if (outcomes != s.tests)
-    throw std::runtime_error("stats: the outcomes (hits, misses, boundary, coplanar, degenerate) add up to " +
-                             std::to_string(outcomes) + ", not tests " + std::to_string(s.tests));
-  for (auto [k, v] : {std::pair{"wrong_t", s.wrong_t}, {"nan_inf", s.nan_inf}, {"double_hits", s.double_hits},
-                      {"t_samples", s.t_samples}, {"groups", s.groups}})
-    if (v > s.tests)
-      throw std::runtime_error(std::string("stats: ") + k + " " + std::to_string(v) + " exceeds tests " +
-                               std::to_string(s.tests));
-  if (s.self_hits > s.spawned)
-    throw std::runtime_error("stats: self_hits " + std::to_string(s.self_hits) + " exceeds spawned " +
-                             std::to_string(s.spawned));
+  check_merged_stats(j, h, s);
   return s;
 }
 
@@ -473,9 +488,8 @@ long long probes_per_sweep(const Family& f, int sweep, long long rays) {
   return std::max(1LL, per);
 }
 
-std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
-                                   long long rays) {
-  std::vector<ProbeCase> out;
+void for_each_probe_case(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays,
+                         const std::function<void(const ProbeCase&)>& visit) {
   const long long n = probes_per_sweep(f, sweep, rays);
   for (long long c = 0; c * kChunk < n; ++c) {
     TriangleBatch b;
@@ -487,9 +501,15 @@ std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std:
         pc.tris.push_back(t);
         pc.answers.push_back(oracle::triangle(pr.ray, t.a, t.b, t.c));
       }
-      out.push_back(std::move(pc));
+      visit(pc);
     }
   }
+}
+
+std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
+                                   long long rays) {
+  std::vector<ProbeCase> out;
+  for_each_probe_case(f, sweep, p, seed, rays, [&](const ProbeCase& pc) { out.push_back(pc); });
   return out;
 }
 
@@ -715,10 +735,10 @@ Report Report::from_json(const nlohmann::json& j) {
       const auto w = std::find(f->sweep.begin(), f->sweep.end(), cell.sweep_label);
       cell.sweep = int(w - f->sweep.begin());
     }
-    try {  // which cell, for a file of thousands
+    try {
       cell.stats = Stats::from_json(need(c, "stats"), c.contains("histograms") ? c["histograms"] : nlohmann::json());
     } catch (const std::runtime_error& e) {
-      throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "]: " + e.what());
+      throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "]." + e.what());
     }
     r.cells.push_back(std::move(cell));
   }

@@ -146,40 +146,56 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
   }
 }
 
-std::string cases_csv(const std::vector<ExportRow>& rows) {
+std::string cases_csv_header() {
   // Appends piece by piece (GCC 12 warns falsely on `"," + std::string`).
   std::string out = "id,family,sweep";
   for (const char* c : kColumns) out.append(",").append(c);
   out.append(",verdict,t\n");
-  for (const ExportRow& r : rows) {
-    out.append(r.id).append(",").append(r.family).append(",").append(r.sweep);
-    const double v[15] = {r.ray.o.x, r.ray.o.y, r.ray.o.z, r.ray.d.x, r.ray.d.y, r.ray.d.z,
-                          r.tri.a.x, r.tri.a.y, r.tri.a.z, r.tri.b.x, r.tri.b.y, r.tri.b.z,
-                          r.tri.c.x, r.tri.c.y, r.tri.c.z};
-    for (double x : v) out.append(",").append(hex(x));
-    out.append(",").append(oracle::verdict_name(r.answer.verdict)).append(",");
-    if (std::isfinite(r.answer.t)) out.append(hex(r.answer.t));
-    out.append("\n");
-  }
   return out;
+}
+
+std::string cases_csv_row(const ExportRow& r) {
+  std::string out;
+  out.append(r.id).append(",").append(r.family).append(",").append(r.sweep);
+  const double v[15] = {r.ray.o.x, r.ray.o.y, r.ray.o.z, r.ray.d.x, r.ray.d.y, r.ray.d.z,
+                        r.tri.a.x, r.tri.a.y, r.tri.a.z, r.tri.b.x, r.tri.b.y, r.tri.b.z,
+                        r.tri.c.x, r.tri.c.y, r.tri.c.z};
+  for (double x : v) out.append(",").append(hex(x));
+  out.append(",").append(oracle::verdict_name(r.answer.verdict)).append(",");
+  if (std::isfinite(r.answer.t)) out.append(hex(r.answer.t));
+  out.append("\n");
+  return out;
+}
+
+std::string cases_csv(const std::vector<ExportRow>& rows) {
+  std::string out = cases_csv_header();
+  for (const ExportRow& r : rows) out.append(cases_csv_row(r));
+  return out;
+}
+
+long long for_each_export_row(const std::vector<std::string>& fams, Precision p, std::uint64_t seed,
+                              long long rays, const std::function<void(const ExportRow&)>& visit) {
+  long long n = 0;
+  for (const Family& f : families()) {
+    if (f.kind != Kind::triangle || f.secondary) continue;
+    if (!fams.empty() && std::find(fams.begin(), fams.end(), f.name) == fams.end()) continue;
+    for (int s = 0; s < int(f.sweep.size()); ++s) {
+      long long i = 0;
+      for_each_probe_case(f, s, p, seed, rays, [&](const ProbeCase& pc) {
+        for (std::size_t k = 0; k < pc.tris.size(); ++k, ++n)
+          visit({f.name + ":" + f.sweep[std::size_t(s)] + ":" + std::to_string(i) + ":" + std::to_string(k), f.name,
+                 f.sweep[std::size_t(s)], pc.ray, pc.tris[k], pc.answers[k]});
+        ++i;
+      });
+    }
+  }
+  return n;
 }
 
 std::vector<ExportRow> export_rows(const std::vector<std::string>& fams, Precision p,
                                    std::uint64_t seed, long long rays) {
   std::vector<ExportRow> rows;
-  for (const Family& f : families()) {
-    if (f.kind != Kind::triangle || f.secondary) continue;
-    if (!fams.empty() && std::find(fams.begin(), fams.end(), f.name) == fams.end()) continue;
-    for (int s = 0; s < int(f.sweep.size()); ++s) {
-      const auto cases = probe_cases(f, s, p, seed, rays);
-      for (std::size_t i = 0; i < cases.size(); ++i)
-        for (std::size_t k = 0; k < cases[i].tris.size(); ++k)
-          rows.push_back({f.name + ":" + f.sweep[std::size_t(s)] + ":" + std::to_string(i) + ":" +
-                              std::to_string(k),
-                          f.name, f.sweep[std::size_t(s)], cases[i].ray, cases[i].tris[k],
-                          cases[i].answers[k]});
-    }
-  }
+  for_each_export_row(fams, p, seed, rays, [&](const ExportRow& r) { rows.push_back(r); });
   return rows;
 }
 

@@ -1,8 +1,8 @@
 #include "pov_runner.h"
 
 #include <fcntl.h>
-#include <cstring>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -41,36 +41,46 @@ struct WorkDir {
   }
 };
 
-
-// The child being waited for, and the signal that interrupted the wait: a
-// SIGINT/SIGTERM/SIGHUP sent to rayaudit alone (timeout, kill) left POV-Ray
-// rendering as an orphan and its working directory in /tmp (HOSTILE2 F30).
-// The handler only forwards the signal (kill is async-signal-safe); the
-// waiter then throws, so the working directory is removed on the way out.
-volatile sig_atomic_t g_child = 0;
+// Ctrl-C, a kill or a hang-up while POV-Ray runs (HOSTILE2 F30: POV-Ray
+// went on rendering as an orphan and its working directory, 64-160 MB, was
+// left in /tmp). While a Interruptible lives, the signal is noted and the
+// child killed at once (only async-signal-safe calls in the handler); when
+// it ends, the working directory is removed and the signal raised again
+// with its default action, so the exit status still says what happened.
 volatile sig_atomic_t g_signal = 0;
+volatile pid_t g_child = 0;
 
-extern "C" void forward_signal(int sig) {
+void on_signal(int sig) {
   g_signal = sig;
-  if (g_child > 0) ::kill(pid_t(g_child), sig);
+  if (g_child > 0) kill(g_child, SIGKILL);
 }
 
-// Installs forward_signal for the wait; restores the previous handlers.
-struct ForwardSignals {
-  static constexpr int kSignals[3] = {SIGINT, SIGTERM, SIGHUP};
-  struct sigaction old[3];
-  explicit ForwardSignals(pid_t child) {
-    g_signal = 0;
-    g_child = child;
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+class Interruptible {
+ public:
+  explicit Interruptible(WorkDir& dir) : dir_(dir) {
     struct sigaction sa {};
-    sa.sa_handler = forward_signal;
+    sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
-    for (int i = 0; i < 3; ++i) sigaction(kSignals[i], &sa, &old[i]);
+    sa.sa_flags = 0;  // no SA_RESTART: wait4 returns EINTR and looks again
+    for (int i = 0; i < 3; ++i) sigaction(kSignals[i], &sa, &old_[i]);
   }
-  ~ForwardSignals() {
-    for (int i = 0; i < 3; ++i) sigaction(kSignals[i], &old[i], nullptr);
-    g_child = 0;
+  ~Interruptible() {
+    for (int i = 0; i < 3; ++i) sigaction(kSignals[i], &old_[i], nullptr);
+    if (const int sig = g_signal) {
+      std::error_code ec;
+      fs::remove_all(dir_.path, ec);
+      signal(sig, SIG_DFL);
+      raise(sig);
+    }
   }
+  Interruptible(const Interruptible&) = delete;
+  Interruptible& operator=(const Interruptible&) = delete;
+
+ private:
+  WorkDir& dir_;
+  struct sigaction old_[3];
 };
 
 }  // namespace
@@ -81,9 +91,14 @@ ProcessRun run_process(const fs::path& dir, const std::vector<std::string>& argv
   for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   const auto t0 = std::chrono::steady_clock::now();
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
+    // The child dies with us, whatever ends us (even SIGKILL): never an
+    // orphan POV-Ray rendering for hours (HOSTILE2 F30).
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(126);
     const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     const int e = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     const int in = open("/dev/null", O_RDONLY);
@@ -94,18 +109,17 @@ ProcessRun run_process(const fs::path& dir, const std::vector<std::string>& argv
     execv(args[0], args.data());
     _exit(127);
   }
+  g_child = pid;
+  if (g_signal) kill(pid, SIGKILL);  // a signal came between fork and here
   int status = 0;
   rusage ru{};
   ProcessRun run;
-  {
-    const ForwardSignals forward(pid);
-    if (g_signal) ::kill(pid, g_signal);  // arrived between fork and here
-    while (wait4(pid, &status, 0, &ru) < 0)
-      if (errno != EINTR) return run;
-  }
-  if (g_signal)
-    throw InputError(std::string(argv[0]) + ": interrupted by signal " + std::to_string(int(g_signal)) +
-                     " (" + strsignal(int(g_signal)) + "); the child was stopped and its files removed");
+  while (wait4(pid, &status, 0, &ru) < 0)
+    if (errno != EINTR) {
+      g_child = 0;
+      return run;
+    }
+  g_child = 0;
   run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run.cpu_s = double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -151,6 +165,7 @@ PovRun run_povray(const PovExport& ex, int width, int height, const PovRunOption
   std::string tmpl = "/tmp/rayaudit-pov-XXXXXX";
   if (!mkdtemp(tmpl.data())) throw InputError("cannot create a working directory under /tmp");
   WorkDir work{tmpl, options.keep_dir};
+  const Interruptible interruptible(work);  // declared after work: ends first
   write_text_atomically(work.path / "scene.pov", ex.sdl);
   write_text_atomically(work.path / "rayaudit.ini", pov_ini(options.bits));
   for (const auto& img : ex.images) copy_pov_image(img.source, work.path / img.name);

@@ -3,8 +3,10 @@
 # as data: URIs, one self-contained index.html and the report.json behind it.
 #
 # Run by `rayaudit report` (cli/cmd_report.cpp) with /usr/bin/python3, which has
-# Debian's matplotlib; that command has already checked every input, so this
-# script trusts their shape and reads them as given in CONTEXT.json.
+# Debian's matplotlib; that command has already checked every input's shape.
+# What only this script can find (an image PIL cannot read or too large to
+# show, anything unforeseen) is one line naming the input and exit 2, never a
+# traceback; rayaudit report then exits 2 without a line of its own.
 import base64
 import datetime
 import glob
@@ -36,6 +38,27 @@ plt.rcParams.update({
 })
 
 THUMB = 160  # largest side of an image thumbnail, pixels
+# Images are decoded whole before shrinking: beyond this many pixels (4096 x
+# 4096, ~50 MB as RGB) one is refused by name rather than decoded, so memory
+# stays in the hundreds of MB; PIL's own guard is replaced by this one
+# (its warning and its error were several lines).
+MAX_IMAGE_PIXELS = 4096 * 4096
+Image.MAX_IMAGE_PIXELS = None
+
+# The input being read, named by the one-line error if something in it
+# cannot be used (HOSTILE2 F25, F40, F42: tracebacks).
+current_input = ["(report context)"]
+
+
+class BadInput(Exception):
+    """A message naming its file, printed as is."""
+
+
+def load_json(path):
+    current_input[0] = path
+    # utf-8-sig: a byte-order mark is skipped, as the C++ checks do (F42).
+    with open(path, encoding="utf-8-sig") as f:
+        return json.load(f)
 ZERO_FLOOR = 1e-5  # where "0 %" is drawn on a log axis
 
 # ------------------------------------------------------------------ helpers --
@@ -50,28 +73,22 @@ def svg_of(fig):
     return text[text.index("<svg"):]
 
 
-class InputFileError(Exception):
-    """A file the C++ checks let through that this script cannot read: one
-    line on stderr, exit 3 (rayaudit then exits 2 without a traceback)."""
-
-
-# compare writes images up to rayaudit's own limit (16384 a side); PIL's
-# decompression-bomb guard stopped at a quarter of that with a traceback.
-Image.MAX_IMAGE_PIXELS = 16384 * 16384
-
-
 def data_uri(path, max_side=THUMB, marks=()):
     """A PNG thumbnail as a data: URI; `marks` (x, y) pixels of the original
     are ringed, so a single differing pixel still shows after shrinking."""
+    current_input[0] = path
     try:
-        return _data_uri(path, max_side, marks)
-    except (OSError, ValueError, Image.DecompressionBombError) as e:
-        raise InputFileError(f"{path}: not a readable image ({type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''})")
-
-
-def _data_uri(path, max_side, marks):
-    with Image.open(path) as im:
-        im = im.convert("RGB")
+        im = Image.open(path)
+    except (OSError, SyntaxError, ValueError) as e:
+        raise BadInput(f"{path}: not a readable image ({type(e).__name__})") from None
+    w, h = im.size
+    if w * h > MAX_IMAGE_PIXELS:
+        raise BadInput(f"{path}: {w}x{h} is too large to show in the report (at most {MAX_IMAGE_PIXELS} pixels)")
+    with im:
+        try:
+            im = im.convert("RGB")
+        except (OSError, SyntaxError, ValueError) as e:
+            raise BadInput(f"{path}: not a readable image ({e})") from None
         w0 = im.size[0]
         if max(im.size) > max_side:
             im.thumbnail((max_side, max_side), Image.NEAREST)
@@ -557,8 +574,7 @@ def images(compare_dirs):
     out = []
     for d in compare_dirs:
         for f in sorted(glob.glob(os.path.join(d, "*.json"))):
-            with open(f, encoding="utf-8-sig") as fh:
-                j = json.load(fh)
+            j = load_json(f)
             if "identical" not in j or "differences" not in j:
                 continue  # not a compare output (e.g. a tolerance file)
             stem = os.path.splitext(os.path.basename(f))[0]
@@ -850,30 +866,30 @@ def finite(v):
 
 
 def main():
-    with open(sys.argv[1]) as f:
-        ctx = json.load(f)
+    ctx = load_json(sys.argv[1])
+    # The file names as bytes (hex): exact even when not UTF-8.
+    for k, v in ctx.get("fs_paths", {}).items():
+        ctx[k] = [os.fsdecode(bytes.fromhex(h)) for h in v] if isinstance(v, list) else os.fsdecode(bytes.fromhex(v))
     methods = Methods(ctx["methods"])
-    with open(ctx["audit"], encoding="utf-8-sig") as f:
-        audit = json.load(f)
+    audit = load_json(ctx["audit"])
     bench = None
     if ctx.get("bench"):
-        with open(ctx["bench"], encoding="utf-8-sig") as f:
-            bench = json.load(f)
+        bench = load_json(ctx["bench"])
     cm, cm_dir = None, ctx.get("crack_maps")
     if cm_dir:
-        with open(os.path.join(cm_dir, "crack_maps.json"), encoding="utf-8-sig") as f:
-            cm = json.load(f)
+        cm = load_json(os.path.join(cm_dir, "crack_maps.json"))
     golden = None
     if ctx.get("golden"):
-        with open(ctx["golden"], encoding="utf-8-sig") as f:
-            golden = json.load(f)["scenes"]
+        golden = load_json(ctx["golden"])["scenes"]
     stages = []
     if ctx.get("stages"):
-        with open(ctx["stages"], encoding="utf-8-sig") as f:
+        current_input[0] = ctx["stages"]
+        with open(ctx["stages"]) as f:
             for line in f:
                 if line.strip():
                     name, secs = line.rstrip("\n").rsplit("\t", 1)
                     stages.append({"stage": name, "seconds": float(secs)})
+    current_input[0] = ctx["audit"]
 
     rep = {
         "have_bench": bench is not None,
@@ -904,16 +920,29 @@ def main():
             uris[p] = data_uri(p, marks=marks[:50])
     text = page(rep, charts, methods, uris)
     out = ctx["out_dir"]
-    with open(os.path.join(out, "index.html"), "w") as f:
+    with open(os.path.join(out, "index.html"), "w", errors="replace") as f:
         f.write(text)
     with open(os.path.join(out, "report.json"), "w") as f:
         json.dump(finite(rep), f, indent=1, allow_nan=False, default=str)
         f.write("\n")
 
 
+def one_line(text):
+    return " ".join(str(text).split())[:500]
+
+
 if __name__ == "__main__":
+    # Never a traceback: bad input is one line naming its file and exit 2,
+    # which rayaudit report passes on (an unforeseen error names the input
+    # being read and the exception, still one line).
     try:
         main()
-    except InputFileError as e:
-        print(str(e).replace("\n", " "), file=sys.stderr)
-        sys.exit(3)
+    except BadInput as e:
+        sys.stderr.write(one_line(e) + "\n")
+        sys.exit(2)
+    except MemoryError:
+        sys.stderr.write(one_line(f"{current_input[0]}: not enough memory to draw the report") + "\n")
+        sys.exit(2)
+    except Exception as e:  # noqa: BLE001
+        sys.stderr.write(one_line(f"{current_input[0]}: cannot be used in the report: {type(e).__name__}: {e}") + "\n")
+        sys.exit(2)
