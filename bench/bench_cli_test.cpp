@@ -253,3 +253,20 @@ TEST(BenchCli, FullDiskKeepsTheOldJson) {
 }
 
 }  // namespace
+
+// HOSTILE2 F35: on a full disk Google Benchmark's writer cut the JSON short
+// and it replaced the previous file, exit 0. Root only (a 64 KiB tmpfs).
+TEST(BenchCli, FullDiskKeepsThePreviousJson) {
+  ra::test::FullDisk disk(1024);
+  if (!disk.ok()) GTEST_SKIP() << disk.why_not();
+  const fs::path out = disk.dir() / "b.json";
+  std::ofstream(out) << "PRECIOUS\n";
+  const auto r = run_rayaudit("bench --filter 'kernel/moller/(float|double)/' --benchmark_repetitions=1 --json " +
+                              out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_NE(r.err.find(out.string() + ": cannot write: "), std::string::npos) << r.err;
+  std::ifstream in(out);
+  std::string kept;
+  std::getline(in, kept);
+  EXPECT_EQ(kept, "PRECIOUS");
+}

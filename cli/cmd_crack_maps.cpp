@@ -105,6 +105,21 @@ void run(const Args& a) {
   const std::filesystem::path parent = std::filesystem::absolute(dir).parent_path();
   if (!std::filesystem::is_directory(parent)) throw ra::InputError(a.out + ": its parent directory does not exist");
 
+  // The work is the product of the flags, each capped alone: at their caps
+  // about 34 hours, silent (HOSTILE2 F38). Refused beyond 2^28 pixels (a few
+  // hours at the ~70 us a pixel measured on the elephant), before any mesh
+  // is read.
+  {
+    const std::uint64_t n_meshes = 1 + (a.meshes.empty() ? 1 : a.meshes.size());
+    const std::uint64_t n_methods = ra::crack::map_methods(opt).size();
+    const std::uint64_t pixels = n_meshes * n_methods * opt.offsets.size() * std::uint64_t(a.size) * std::uint64_t(a.size);
+    constexpr std::uint64_t kMaxPixels = std::uint64_t(1) << 28;
+    if (pixels > kMaxPixels)
+      throw ra::InputError("crack-maps: " + std::to_string(n_meshes) + " meshes x " + std::to_string(n_methods) +
+                           " methods x " + std::to_string(opt.offsets.size()) + " offsets x " + std::to_string(a.size) +
+                           "^2 pixels = " + std::to_string(pixels) + " pixels, more than the limit of " +
+                           std::to_string(kMaxPixels) + " (hours of work): fewer --offsets or --methods, or a smaller --size");
+  }
   std::vector<ra::crack::ClosedMesh> meshes{ra::crack::audit_sphere()};
   if (a.meshes.empty()) {
     const auto f = default_ladder_mesh();

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
+#include "io/file_identity.h"
 #include "command.h"
 #include "errors.h"
 #include "golden.h"
@@ -31,7 +32,18 @@ std::vector<std::string> names_of(const std::vector<std::string>& given, const r
     std::string rel = p.generic_string();
     if (rel.rfind("scenes/", 0) == 0) rel = rel.substr(7);
     const bool plain = !p.is_absolute() && rel.find("..") == std::string::npos;
-    out.push_back(plain ? rel : p.filename().string());
+    if (!plain) {
+      // A path elsewhere was checked as ROOT/scenes/<its stem>.json, and that
+      // file named in the error (HOSTILE2 F23): a path must be under scenes/.
+      std::error_code ec;
+      const std::filesystem::path scenes = std::filesystem::weakly_canonical(set.root() / "scenes", ec);
+      const std::filesystem::path under = std::filesystem::weakly_canonical(p, ec).lexically_relative(scenes);
+      if (under.empty() || *under.begin() == "..")
+        throw ra::InputError(ra::located(g, 0, "not a scene under " + (set.root() / "scenes").string() +
+                                                   " (golden names scenes by their path there)"));
+      rel = under.generic_string();
+    }
+    out.push_back(rel);
   }
   return out;
 }
@@ -54,6 +66,18 @@ void check(const Args& a) {
   if (names.empty())
     throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
                          ": no golden images to check");
+  // Every image a failure may write, declared before the work: the golden
+  // itself (--diff-dir ROOT/golden replaced it with this render, and the
+  // next check passed), --json, or another scene's inputs are refused.
+  for (const auto& n : names) {
+    for (const std::filesystem::path& in : set.inputs_of(n))
+      if (std::filesystem::is_regular_file(in)) ra::note_input(in);
+    std::error_code ec;  // a folder not there yet holds no input
+    if (std::filesystem::is_directory((diff_dir / n).parent_path(), ec)) {
+      outputs.add(diff_dir / (n + ".diff.png"));
+      outputs.add(diff_dir / (n + ".png"));
+    }
+  }
   for (const auto& n : names) {
     const auto missing = ra::missing_cache_inputs(std::filesystem::path(a.root) / "scenes" / (n + ".json"));
     if (a.skip_unavailable && !missing.empty()) {
@@ -70,21 +94,25 @@ void check(const Args& a) {
     failed += !r.pass;
   }
   // Written whatever the verdict: a failed check is what the report must show.
-  if (!a.json.empty()) {
-    ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1) + "\n");
-    outputs.commit();
-  }
+  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  outputs.commit();  // the JSON and the diff images
   if (failed)
     throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
                           " golden image(s) failed");
   if (skipped == int(names.size())) throw ra::cli::ExitCode{77};
 }
 
+// Every scene is rendered before anything is renamed into golden/: a scene
+// that fails (exit 2) leaves every golden and the manifest as they were
+// (`bless A BAD` rewrote A's image, its manifest entry stale: issue 15).
 void bless(const Args& a) {
   check_root(a);
+  ra::OutputBatch outputs({});
   ra::GoldenSet set(a.root);
-  for (const auto& n : names_of(a.scenes, set)) std::cout << set.bless(n) << "\n";
-  set.save();
+  std::string said;
+  for (const auto& n : names_of(a.scenes, set)) said += set.bless(n, &outputs) + "\n";
+  set.save(&outputs);
+  std::cout << said;
 }
 
 void setup(CLI::App& app) {

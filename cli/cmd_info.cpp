@@ -1,10 +1,13 @@
 // `rayaudit info FILE [--json] [--threads N]`: what an OBJ file holds, as the
 // loader sees it (counts after triangulation, area, bbox, names, warnings).
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "command.h"
+#include "errors.h"
 #include "formats/mesh.h"
 
 namespace {
@@ -26,6 +29,13 @@ void setup(CLI::App& app) {
   cmd->callback([o] {
     ra::ObjOptions opt;
     opt.threads = o->threads;
+    // A PLY, OFF or scene JSON read as an OBJ of unknown statements: an
+    // empty mesh and exit 0 (HOSTILE2 F32); render refuses them by name.
+    std::string ext = std::filesystem::path(o->file).extension().string();
+    for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (ext == ".ply" || ext == ".off" || ext == ".json")
+      throw ra::InputError(ra::located(o->file, 0, "a " + ext.substr(1) + " file: info reads OBJ meshes" +
+                                                       (ext == ".json" ? std::string() : " (rayaudit convert it to OBJ first)")));
     const ra::Mesh m = ra::load_obj(o->file, opt);
     const ra::Bounds3d b = m.bbox();
     auto vec = [](const ra::Vec3d& v) { return nlohmann::json::array({v.x, v.y, v.z}); };

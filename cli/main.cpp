@@ -16,8 +16,29 @@ std::vector<Command>& commands() {
 }
 }  // namespace ra::cli
 
+namespace {
+
+// An empty value is never meant: `--json ""` wrote nothing and exited 0,
+// `-o ""` failed late, `--seed ""` said something about a conversion. Every
+// option that takes a value (and every positional) refuses "" by name.
+void refuse_empty_values(CLI::App& app) {
+  const CLI::Validator non_empty(
+      [](std::string& v) { return v.empty() ? std::string("empty value (a file name or value is needed)") : std::string(); },
+      "", "NON_EMPTY");
+  for (CLI::Option* opt : app.get_options())
+    if (opt->get_type_size_max() > 0) opt->check(non_empty);
+  for (CLI::App* sub : app.get_subcommands({})) refuse_empty_values(*sub);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   // Answered before any command is set up, with its newline.
+  // `--version extra` printed the version and exited 0, the extra ignored.
+  if (argc > 2 && std::string_view(argv[1]) == "--version") {
+    std::cerr << "rayaudit: --version takes no arguments, got '" << argv[2] << "' (see --help)\n";
+    return 2;
+  }
   if (argc == 2 && std::string_view(argv[1]) == "--version") {
     std::cout << "rayaudit " << RAYAUDIT_VERSION << "\n";
     return 0;
@@ -28,6 +49,7 @@ int main(int argc, char** argv) {
   auto& cmds = ra::cli::commands();
   std::sort(cmds.begin(), cmds.end(), [](auto& a, auto& b) { return a.order < b.order; });
   for (auto& c : cmds) c.setup(app);
+  refuse_empty_values(app);
   // CLI11 would call an unknown command "A subcommand is required": name it.
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;

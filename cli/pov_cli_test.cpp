@@ -280,3 +280,7 @@ TEST(CompareRandomCliSlow, UnexplainedPixelExits1AndWritesAMinimalScene) {
 }
 
 }  // namespace
+
+namespace {
+
+}  // namespace

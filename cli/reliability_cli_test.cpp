@@ -2,6 +2,7 @@
 // system refuses, work and destinations checked first, inputs that are not
 // files, options that used to be accepted silently.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -218,18 +219,49 @@ namespace {
 // A legal 16384 x 16384 texture (a 32 KB PNG: 1-bit grey, all zero, deflated)
 // that a process limited to 3 GB cannot hold: one line naming the file, not
 // a bare std::bad_alloc.
-TEST(ReliabilityCli, TextureTooLargeForMemoryNamesTheFile) {
+// A 32 KB 1-bit PNG of 16384 x 16384 peaked at 1.24 GB (a float copy of
+// every channel, then 3 floats a texel) before "not enough memory" under
+// 4 GB. Textures keep the file's own 8 bits now (256 MB here): it renders
+// under 3 GB, and under 700 MB (OIIO's libraries map ~500 MB) it is refused
+// from its size before the buffer is allocated, naming the file.
+TEST(ReliabilityCli, Texture16384OneBitLoadsInItsOwnBytesOrIsRefusedUpFront) {
   SKIP_IF_SANITIZED();
   const std::string tex = std::string(RAYAUDIT_SOURCE_DIR) + "/cli/testdata/texture-16384-1bit.png";
   const fs::path scene = scratch("bigtex.json");
   std::ofstream(scene) << R"({"objects": [{"mesh": ")" << kScenes << R"(/meshes/quad.obj", "material": {"texture": ")"
                        << tex << "\"}}]}\n";
-  const auto r = run_rayaudit("render " + scene.string() + " --width 8 --height 8 -o " + scratch("bigtex.png").string(),
-                              "prlimit --as=3000000000 --");
+  const std::string args = "render " + scene.string() + " --width 8 --height 8 -o " + scratch("bigtex.png").string();
+  rusage before{};
+  ::getrusage(RUSAGE_CHILDREN, &before);
+  const auto ok = run_rayaudit(args, "prlimit --as=3000000000 --");
+  EXPECT_EQ(ok.code, 0) << ok.all;
+  rusage after{};
+  ::getrusage(RUSAGE_CHILDREN, &after);
+  // Largest child so far: this run, unless an earlier child was larger.
+  if (after.ru_maxrss > before.ru_maxrss) EXPECT_LT(after.ru_maxrss, 700L * 1024) << "peak resident KB";
+  const auto r = run_rayaudit(args, "prlimit --as=700000000 --");
+  if (r.code == 0) GTEST_SKIP() << "OpenImageIO's libraries map less here: 700 MB holds the texture";
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(one_line(r.err)) << r.err;
-  EXPECT_EQ(r.err.rfind(tex + ": ", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.rfind(tex + ": texture of 16384x16384 needs 256 MB to read, but only ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("not enough memory"), std::string::npos) << r.err;
+}
+
+// Under an address-space limit too low for OpenImageIO's libraries (they
+// map ~430 MB and start threads as they load), every image command aborted,
+// segfaulted or hung at 410-450 MB, or blamed a valid texture up to ~520 MB
+// (HOSTILE2 F28). The module is refused before it is loaded, in one line.
+TEST(ReliabilityCli, ImageModuleUnderALowAddressSpaceLimitIsOneLine) {
+  SKIP_IF_SANITIZED();
+  for (const char* limit : {"300000000", "410000000", "430000000", "450000000", "500000000"}) {
+    const auto r = run_rayaudit("render " + kScenes + "/bump-height.json --width 8 --height 8 -o " +
+                                    scratch("lowas.png").string(),
+                                std::string("prlimit --as=") + limit + " --");
+    EXPECT_EQ(r.code, 2) << limit << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << limit << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("rayaudit_image.so: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("MB of address space to load"), std::string::npos) << r.err;
+  }
 }
 
 // An existing output that is not a regular file is refused before any work:
@@ -467,3 +499,196 @@ TEST(ReliabilityCli, CompareRandomOutWithAMissingParentIsRefused) {
 }
 
 }  // namespace
+
+// Issue 15's fourth pass: `audit --json ""` wrote nothing and exited 0; every
+// option given an empty value is refused by name before any work.
+TEST(ReliabilityCli, EmptyOptionValuesAreRefusedByName) {
+  const fs::path dir = scratch("empty-values");
+  fs::create_directories(dir);
+  const std::string scene = kScenes + "/doc002-tetrahedron.json";
+  const std::pair<std::string, std::string> cases[] = {
+      {"audit --methods moller --families edge --rays 10 --json ''", "--json"},
+      {"audit --methods moller --families edge --rays 10 --csv ''", "--csv"},
+      {"audit --methods moller --families edge --rays 10 --export-cases ''", "--export-cases"},
+      {"render " + scene + " -o ''", "--output"},
+      {"compare " + scene + " --width 8 --height 8 --diff ''", "--diff"},
+      {"convert " + kScenes + "/meshes/quad.obj -o ''", "--output"},
+      {"golden check --root " + std::string(RAYAUDIT_SOURCE_DIR) + " --diff-dir '' doc002-tetrahedron", "--diff-dir"},
+      {"render '' -o " + (dir / "x.png").string(), "scene"},
+  };
+  for (const auto& [args, flag] : cases) {
+    const auto r = run_rayaudit(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
+    EXPECT_TRUE(one_line(r.err)) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(flag + ": empty value"), std::string::npos) << args << "\n" << r.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+  fs::remove_all(dir);
+}
+
+// Issue 15's fourth pass: `golden check --diff-dir ROOT/golden` replaced the
+// golden it compared against with this render (the next check passed);
+// --json naming a diff image lost the render; `golden bless A BAD` rewrote
+// A's image and failed on BAD, leaving the manifest stale.
+TEST(ReliabilityCli, GoldenOutputsNeverReplaceInputsAndBlessIsAllOrNothing) {
+  const fs::path root = scratch("golden-io");
+  fs::remove_all(root);
+  fs::create_directories(root / "scenes");
+  fs::create_directories(root / "out");
+  std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}}]})"
+                                             << "\n";
+  ASSERT_EQ(run_rayaudit("golden bless t --root " + root.string()).code, 0);
+  // A golden that differs from the render: a check fails and writes its images.
+  std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 0.5}}]})"
+                                             << "\n";
+  const std::string golden = slurp(root / "golden" / "t.png"), manifest = slurp(root / "golden" / "manifest.json");
+  auto r = run_rayaudit("golden check t --root " + root.string() + " --diff-dir " + (root / "golden").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("t.png: is also an input of this command"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(root / "golden" / "t.png"), golden);
+  EXPECT_FALSE(fs::exists(root / "golden" / "t.diff.png"));
+
+  r = run_rayaudit("golden check t --root " + root.string() + " --diff-dir " + (root / "out").string() + " --json " +
+                   (root / "out" / "t.png").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_NE(r.err.find("is named as two outputs of this command"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(root / "out"));
+
+  std::ofstream(root / "scenes" / "zbad.json") << R"({"objects": [{"mesh": "meshes/nosuch.obj"}]})" << "\n";
+  r = run_rayaudit("golden bless t zbad --root " + root.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_NE(r.err.find("zbad.json: /objects/0/mesh: file not found"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(root / "golden" / "t.png"), golden) << "rewritten although the bless failed";
+  EXPECT_EQ(slurp(root / "golden" / "manifest.json"), manifest);
+  fs::remove_all(root);
+}
+
+// HOSTILE2 F1, F2: a second precision for --export-cases was dropped
+// silently (a file of double cases, exit 0); `--version extra` exited 0.
+TEST(ReliabilityCli, ExportCasesWithTwoPrecisionsAndVersionWithAnArgumentAreRefused) {
+  const fs::path out = scratch("two-precisions.csv");
+  auto r = run_rayaudit("audit --export-cases " + out.string() + " --precision float,double --rays 10");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, "--precision: --export-cases takes one precision (float or double), got 'float,double'\n");
+  EXPECT_FALSE(fs::exists(out));
+  r = run_rayaudit("audit --export-cases " + out.string() + " --precision float --rays 10");
+  EXPECT_EQ(r.code, 0) << r.all;
+  r = run_rayaudit("--version extra");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  fs::remove(out);
+}
+
+// HOSTILE2 F22: an OBJ read through its memory map was not noted as an
+// input, so `crack-maps --mesh` naming one of its own maps overwrote it.
+TEST(ReliabilityCli, CrackMapsMeshThatIsOneOfItsMapsIsRefused) {
+  const fs::path dir = scratch("cm-mesh-input");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path mesh = dir / "sphere-moller-1.png";
+  fs::copy_file(kScenes + "/meshes/tetrahedron.obj", mesh);
+  const std::string before = slurp(mesh);
+  const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + mesh.string() +
+                              " --methods moller --offsets 1 --size 8");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("sphere-moller-1.png: is also an input of this command"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(mesh), before);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+  fs::remove_all(dir);
+}
+
+// HOSTILE2 F31, F32, F39: a non-UTF-8 CSV id made the JSON writer throw
+// after the work; info read a PLY or a scene as an empty OBJ (exit 0); an
+// OBJ reader trusting st_size read /proc files as empty.
+TEST(ReliabilityCli, NonUtf8IdsInfoOnNonObjAndProcFiles) {
+  const fs::path dir = scratch("f31");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "c.csv") << "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n\xff\xfex,0,0,5,0,0,-1,-1,-1,0,1,-1,0,0,1,0\n";
+  auto r = run_rayaudit("audit --cases " + (dir / "c.csv").string() + " --methods moller --json " + (dir / "o.json").string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(slurp(dir / "o.json").find("\"id\": \"\xEF\xBF\xBD\xEF\xBF\xBDx\""), std::string::npos) << "replaced, valid UTF-8";
+  std::ofstream(dir / "t.ply") << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
+  r = run_rayaudit("info " + (dir / "t.ply").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, (dir / "t.ply").string() + ": a ply file: info reads OBJ meshes (rayaudit convert it to OBJ first)\n");
+  r = run_rayaudit("info /proc/self/status");
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.err.find("/proc/self/status:1: unsupported statement 'Name:'"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
+// HOSTILE2 F42: an audit JSON with a UTF-8 BOM passed the C++ checks and
+// ended in a 13-line Python traceback; report.py reads it as utf-8-sig.
+TEST(ReliabilityCli, ReportReadsAnAuditJsonWithABom) {
+  const fs::path dir = scratch("report-bom");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path audit = dir / "a.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
+  std::ofstream(dir / "bom.json") << "\xEF\xBB\xBF" << slurp(audit);
+  const auto r = run_rayaudit("report --audit " + (dir / "bom.json").string() + " -o " + (dir / "rep").string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(dir / "rep" / "index.html"));
+  fs::remove_all(dir);
+}
+
+// HOSTILE2 F40: an image beside a compare JSON that PIL cannot open ended
+// the report in a 13-line traceback; it is one line naming the image.
+TEST(ReliabilityCli, ReportWithAnUnreadableCompareImageIsOneLine) {
+  const fs::path dir = scratch("report-f40");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "cmp");
+  const fs::path audit = dir / "a.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
+  std::ofstream(dir / "cmp" / "x.json") << R"({"width": 8, "height": 8, "differing": 0, "identical": true, "differences": []})";
+  std::ofstream(dir / "cmp" / "x-pov.png") << "not a png\n";
+  const auto r = run_rayaudit("report --audit " + audit.string() + " --compare " + (dir / "cmp").string() + " -o " +
+                              (dir / "rep").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind((dir / "cmp" / "x-pov.png").string() + ": not a readable image (", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "rep"));
+  fs::remove_all(dir);
+}
+
+// HOSTILE2 F19 addendum: a 10 MB usemtl name was a 10 MB warning line.
+TEST(ReliabilityCli, LongMaterialNamesAreQuotedShort) {
+  const fs::path obj = scratch("long-usemtl.obj");
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl " << std::string(1000000, 'u') << "\nf 1 2 3\n";
+  const auto r = run_rayaudit("info " + obj.string());
+  EXPECT_EQ(r.code, 0) << r.err.substr(0, 300);
+  EXPECT_LT(r.err.size(), 1000u);
+  EXPECT_NE(r.err.find("... (1000000 bytes)' is not defined"), std::string::npos) << r.err.substr(0, 300);
+}
+
+// HOSTILE2 F38: crack-maps' flags are capped one by one, their product was
+// about 34 hours of silent work; it is refused before any mesh is read.
+TEST(ReliabilityCli, CrackMapsWorkBeyondItsLimitIsRefusedUpFront) {
+  std::string offsets = "1";
+  for (int i = 2; i <= 100; ++i) offsets += "," + std::to_string(i);
+  const fs::path out = scratch("cm-huge");
+  const auto r = run_rayaudit("crack-maps -o " + out.string() + " --size 1024 --offsets " + offsets);
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("= 1677721600 pixels, more than the limit of 268435456"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// HOSTILE2 F23: `golden check /elsewhere/x.json` checked ROOT/scenes/x.json
+// and named that file; a path outside scenes/ is refused as such, and an
+// absolute path inside it is its scene.
+TEST(ReliabilityCli, GoldenCheckOfAPathOutsideScenesIsNamedAsSuch) {
+  const std::string root = RAYAUDIT_SOURCE_DIR;
+  auto r = run_rayaudit("golden check /tmp/any/where/x.json --root " + root);
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err.rfind("/tmp/any/where/x.json: not a scene under ", 0), 0u) << r.err;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  r = run_rayaudit("golden check " + root + "/scenes/doc000-pyramid.json --root " + root + " --diff-dir " +
+                   scratch("gd").string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.out.find("ok   doc000-pyramid: identical"), std::string::npos) << r.out;
+}

@@ -14,6 +14,8 @@
 #include "errors.h"
 #include "image_module.h"
 #include "io/input_file.h"
+#include "image_checks.h"
+#include "memory_budget.h"
 
 namespace ra {
 
@@ -103,45 +105,125 @@ class QuietStderr {
 
 }  // namespace
 
-std::vector<float> read_pixels(const std::filesystem::path& path, const char* what, int& width, int& height,
-                               int& channels) {
-  check_input_file(path);  // a FIFO would block OIIO forever; a directory is "not a PNG file"
-  std::error_code ec;
-  const std::uint64_t bytes = std::filesystem::file_size(path, ec);
-  const std::string name = path.string();
-  const image_module::Api& oiio = image_module::api();
-  QuietStderr quiet;
-  image_module::Header spec;
-  std::string err;
-  const std::unique_ptr<void, void (*)(void*)> in(oiio.open(name.c_str(), &spec, &err), oiio.close);
-  if (!in) throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + err));
-  const std::uint64_t w = std::uint64_t(std::max(spec.width, 0)), h = std::uint64_t(std::max(spec.height, 0));
+namespace {
+
+// The header's size is trusted only as far as the file can hold it: at
+// most kMaxPixelsPerByte pixels a byte, and never beyond the render limit.
+// bytes 0: unknown (not checked).
+void check_declared_size(const std::string& name, const char* what, std::uint64_t w, std::uint64_t h,
+                         std::uint64_t bytes) {
   const std::string dims = std::to_string(w) + "x" + std::to_string(h);
-  if (w == 0 || h == 0 || spec.channels < 1 || spec.channels > 64)
-    throw InputError(located(name, 0, what + std::string(" header declares ") + dims + " with " +
-                                          std::to_string(spec.channels) + " channels"));
-  // The header's size is trusted only as far as the file can hold it: at
-  // most kMaxPixelsPerByte pixels a byte, and never beyond the render limit.
   if (w > kMaxImageSide || h > kMaxImageSide)
     throw InputError(located(name, 0, what + std::string(" is ") + dims + ", more than the limit of " +
                                           std::to_string(kMaxImageSide) + " pixels a side"));
-  if (!ec && w * h > bytes * kMaxPixelsPerByte)
+  if (bytes && w * h > bytes * kMaxPixelsPerByte)
     throw InputError(located(name, 0, what + std::string(" header declares ") + dims + " pixels, more than its " +
                                           std::to_string(bytes) + " bytes can hold (the file is truncated or corrupt)"));
-  width = int(w);
-  height = int(h);
-  channels = spec.channels;
-  std::vector<float> all;
+}
+
+// An image opened by the module, its header checked against the limits.
+struct OpenedImage {
+  std::unique_ptr<void, void (*)(void*)> in{nullptr, [](void*) {}};
+  image_module::Header spec;
+  std::string name, dims;
+};
+
+OpenedImage open_checked(const std::filesystem::path& path, const char* what) {
+  check_input_file(path);  // a FIFO would block OIIO forever; a directory is "not a PNG file"
+  const std::string name = path.string();
+  // What OIIO's readers accept silently (a PNG without IEND, a PNM maxval
+  // of 0), or an empty file, said before OIIO is asked.
+  const ImageProblem why = image_container_problem(path);
+  if (!why.what.empty()) throw InputError(located(name, why.line, std::string("cannot read ") + what + ": " + why.what));
+  std::error_code ec;
+  const std::uint64_t bytes = std::filesystem::file_size(path, ec);
+  if (why.width || why.height) check_declared_size(name, what, why.width, why.height, ec ? 0 : bytes);
+  const image_module::Api& oiio = image_module::api();
+  OpenedImage o;
+  o.name = name;
+  std::string err;
+  o.in = std::unique_ptr<void, void (*)(void*)>(oiio.open(name.c_str(), &o.spec, &err), oiio.close);
+  if (!o.in) throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + image_open_problem(path, err)));
+  const image_module::Header& spec = o.spec;
+  const std::uint64_t w = std::uint64_t(std::max(spec.width, 0)), h = std::uint64_t(std::max(spec.height, 0));
+  o.dims = std::to_string(w) + "x" + std::to_string(h);
+  if (w == 0 || h == 0 || spec.channels < 1 || spec.channels > 64)
+    throw InputError(located(name, 0, what + std::string(" header declares ") + o.dims + " with " +
+                                          std::to_string(spec.channels) + " channels"));
+  check_declared_size(name, what, w, h, ec ? 0 : bytes);
+  return o;
+}
+
+// A buffer of n values, its size checked against the memory left first.
+template <class T>
+void allocate(std::vector<T>& v, std::uint64_t n, const OpenedImage& o, const char* what) {
+  const std::uint64_t need = n * sizeof(T), avail = available_memory();
+  auto fail = [&] {
+    throw InputError(located(o.name, 0, what + std::string(" of ") + o.dims + " needs " +
+                                            std::to_string((need + (1 << 20) - 1) >> 20) + " MB to read, but only " +
+                                            std::to_string(avail >> 20) +
+                                            " MB are available (free memory, or `ulimit -v`): not enough memory"));
+  };
+  if (need > avail) fail();
   try {
-    all.resize(std::size_t(w * h) * std::size_t(channels));
+    v.resize(std::size_t(n));
   } catch (const std::bad_alloc&) {  // a legal size this machine cannot hold: still about this file
-    throw InputError(located(name, 0, what + std::string(" of ") + dims + " needs " +
-                                          std::to_string(w * h * std::uint64_t(channels) * 4 >> 20) +
-                                          " MB to read: not enough memory"));
+    fail();
   }
-  if (!oiio.read(in.get(), channels, all.data(), &err))
-    throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + err));
+}
+
+void read_into(const OpenedImage& o, int channels, int type, void* dst, const char* what) {
+  std::string err;
+  if (!image_module::api().read(o.in.get(), channels, type, dst, &err))
+    throw InputError(located(o.name, 0, std::string("cannot read ") + what + ": " + err));
+}
+
+}  // namespace
+
+std::vector<float> read_pixels(const std::filesystem::path& path, const char* what, int& width, int& height,
+                               int& channels) {
+  QuietStderr quiet;
+  const OpenedImage o = open_checked(path, what);
+  width = o.spec.width;
+  height = o.spec.height;
+  channels = o.spec.channels;
+  std::vector<float> all;
+  allocate(all, std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(channels), o, what);
+  read_into(o, channels, image_module::kFloat, all.data(), what);
   return all;
+}
+
+StoredPixels read_stored_pixels(const std::filesystem::path& path, const char* what) {
+  QuietStderr quiet;
+  const OpenedImage o = open_checked(path, what);
+  StoredPixels p;
+  p.width = o.spec.width;
+  p.height = o.spec.height;
+  p.channels = o.spec.channels >= 3 ? 3 : 1;
+  const std::uint64_t n = std::uint64_t(p.width) * std::uint64_t(p.height) * std::uint64_t(p.channels);
+  switch (o.spec.type) {
+    case image_module::kUint8:
+      allocate(p.u8, n, o, what);
+      read_into(o, p.channels, image_module::kUint8, p.u8.data(), what);
+      break;
+    case image_module::kUint16:
+      allocate(p.u16, n, o, what);
+      read_into(o, p.channels, image_module::kUint16, p.u16.data(), what);
+      break;
+    default:
+      allocate(p.f, n, o, what);
+      read_into(o, p.channels, image_module::kFloat, p.f.data(), what);
+      // A NaN or infinite texel (PFM, EXR) rendered black, silently: every
+      // other reader refuses non-finite numbers.
+      for (std::size_t i = 0; i < p.f.size(); ++i)
+        if (!std::isfinite(p.f[i])) {
+          const std::size_t px = i / std::size_t(p.channels);
+          throw InputError(located(o.name, 0, std::string(what) + " texel (" + std::to_string(px % std::size_t(p.width)) +
+                                                  ", " + std::to_string(px / std::size_t(p.width)) + ") is " +
+                                                  (std::isnan(p.f[i]) ? "NaN" : "infinite") + ", not a colour"));
+        }
+  }
+  return p;
 }
 
 Image read_image(const std::filesystem::path& path) {

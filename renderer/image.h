@@ -46,6 +46,23 @@ constexpr std::uint64_t kMaxPixelsPerByte = 8 * 1032;
 std::vector<float> read_pixels(const std::filesystem::path& path, const char* what, int& width, int& height,
                                int& channels);
 
+// An image's pixels as a texture keeps them: grey (1 channel: a grey or
+// grey + alpha file) or RGB (3: alpha and further channels dropped), in the
+// file's own 8 or 16 bits when it has them (value v means v / 255 or
+// v / 65535, as OpenImageIO converts), else float. A 16384 x 16384 1-bit
+// PNG is 256 MB here, not the 1 GB + 3 GB of float channels it was.
+struct StoredPixels {
+  int width = 0, height = 0, channels = 0;
+  std::vector<std::uint8_t> u8;
+  std::vector<std::uint16_t> u16;
+  std::vector<float> f;  // exactly one of the three holds width * height * channels values
+};
+
+// read_pixels' checks, then the pixels as StoredPixels. The decoded size is
+// checked against the memory available (memory_budget.h) before anything is
+// allocated: "texture of WxH needs N MB ...".
+StoredPixels read_stored_pixels(const std::filesystem::path& path, const char* what);
+
 // Reads any image OpenImageIO can read, as linear float RGB (no colour
 // conversion: a PNG's 8-bit values v become v / 255).
 Image read_image(const std::filesystem::path& path);

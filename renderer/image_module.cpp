@@ -6,10 +6,15 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <algorithm>
+#include <cstdint>
 #include <mutex>
+#include <thread>
 #include <string>
+#include <system_error>
 
 #include "errors.h"
+#include "memory_budget.h"
 
 namespace ra::image_module {
 namespace {
@@ -31,6 +36,23 @@ std::vector<std::string> candidates() {
   return out;
 }
 
+// OpenImageIO and its ~260 libraries map about 430 MB of address space as
+// they load (2 cores), and some start threads in their initialisers. Under
+// an address-space limit (`ulimit -v`, prlimit --as) that leaves less, the
+// load or the first read aborted, segfaulted or hung inside those libraries
+// (410-450 MB: HOSTILE2 F28), or blamed a valid texture. Refused here,
+// before dlopen, with one line: 480 MB and a thread stack (8 MB) a core.
+void check_address_space() {
+  const std::uint64_t need = (std::uint64_t(480) << 20) +
+                             (std::uint64_t(8) << 20) * std::max(1u, std::thread::hardware_concurrency());
+  const std::uint64_t left = address_space_left();
+  if (left < need)
+    throw InputError(located(kFileName, 0,
+                             "the image module (OpenImageIO) needs about " + std::to_string(need >> 20) +
+                                 " MB of address space to load, but only " + std::to_string(left >> 20) +
+                                 " MB are left under the address-space limit (`ulimit -v`): raise it"));
+}
+
 const Api* load() {
   std::string tried;
   for (const std::string& path : candidates()) {
@@ -38,7 +60,20 @@ const Api* load() {
     std::error_code ec;
     tried += (tried.empty() ? "" : ", ") + (by_name ? "the library path" : path);
     if (!by_name && !fs::exists(path, ec)) continue;
-    void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    void* handle = nullptr;
+    try {
+      // Through a pointer of a type that may throw: glibc declares dlopen
+      // noexcept, and the handler would be compiled away.
+      void* (*volatile open_fn)(const char*, int) = ::dlopen;
+      handle = open_fn(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    } catch (const std::system_error& e) {
+      // OpenImageIO's dependencies start threads in their initialisers: under
+      // a low `ulimit -v` that throws out of dlopen ("rayaudit: error:
+      // Resource temporarily unavailable", naming nothing).
+      throw InputError(located(by_name ? std::string(kFileName) : path, 0,
+                               std::string("cannot load the image module: ") + e.what() +
+                                   " (a library's thread could not start: is the address-space limit `ulimit -v` too low?)"));
+    }
     if (!handle) {
       // A file that is there but does not load (a missing OpenImageIO
       // library, a wrong architecture) is the answer, not the next place.
@@ -66,7 +101,10 @@ const Api& api() {
   static std::mutex m;
   static const Api* loaded = nullptr;
   std::lock_guard<std::mutex> lock(m);
-  if (!loaded) loaded = load();
+  if (!loaded) {
+    check_address_space();
+    loaded = load();
+  }
   return *loaded;
 }
 

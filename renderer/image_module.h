@@ -13,10 +13,14 @@
 namespace ra::image_module {
 
 // Bumped whenever Api changes: a stale module beside a newer rayaudit is refused.
-constexpr int kVersion = 1;
+constexpr int kVersion = 2;
+
+// Pixel types read() converts to (and a file's own, in Header::type).
+enum PixelType : int { kFloat = 0, kUint8 = 1, kUint16 = 2 };
 
 struct Header {
   int width = 0, height = 0, channels = 0;
+  int type = kFloat;  // the file's own: kUint8, kUint16, or kFloat for anything else
 };
 
 // OIIO's ImageBufAlgo::compare, field for field.
@@ -36,9 +40,10 @@ struct Api {
   // A float RGB EXR written to `path`, close() checked (full disk).
   bool (*write_exr)(const char* path, int w, int h, const float* rgb, std::string* err);
   // Opens an image and reads its header; nullptr and *err (first line of
-  // OIIO's text) on failure. read() fills w*h*channels floats; close() frees.
+  // OIIO's text) on failure. read() fills w*h*channels values of `type` (a
+  // PixelType) from the first `channels` channels; close() frees.
   void* (*open)(const char* path, Header* header, std::string* err);
-  bool (*read)(void* image, int channels, float* dst, std::string* err);
+  bool (*read)(void* image, int channels, int type, void* dst, std::string* err);
   void (*close)(void* image);
   // ImageBufAlgo::compare of two float RGB images of w x h.
   void (*compare)(int w, int h, const float* a, const float* b, float fail, float warn, CompareStats* out);

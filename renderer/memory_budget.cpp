@@ -44,16 +44,14 @@ std::string megabytes(std::uint64_t bytes) { return std::to_string((bytes + (1 <
 
 }  // namespace
 
-std::uint64_t available_memory() {
-  std::uint64_t avail = system_available();
+std::uint64_t address_space_left() {
   rlimit as{};
-  if (::getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) {
-    const std::uint64_t used = mapped_now();
-    const std::uint64_t left = as.rlim_cur > used ? as.rlim_cur - used : 0;
-    avail = std::min(avail, left);
-  }
-  return avail;
+  if (::getrlimit(RLIMIT_AS, &as) != 0 || as.rlim_cur == RLIM_INFINITY) return std::numeric_limits<std::uint64_t>::max();
+  const std::uint64_t used = mapped_now();
+  return as.rlim_cur > used ? as.rlim_cur - used : 0;
 }
+
+std::uint64_t available_memory() { return std::min(system_available(), address_space_left()); }
 
 void check_image_memory(const std::string& what, int width, int height, int bytes_per_pixel) {
   const std::uint64_t need = std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(bytes_per_pixel);

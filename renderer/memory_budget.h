@@ -11,6 +11,11 @@ namespace ra {
 // now, and the system's MemAvailable + SwapFree. UINT64_MAX if unknown.
 std::uint64_t available_memory();
 
+// Only the address-space limit's part of it (what RLIMIT_AS leaves beside
+// what is mapped now): address space, not memory, is what a library's
+// mappings take. UINT64_MAX when there is no limit.
+std::uint64_t address_space_left();
+
 // Throws InputError "WxH needs about N MB for its image buffers; M MB are
 // available ..." when width x height x bytes_per_pixel exceeds
 // available_memory(). `what` names the work ("render", "compare").

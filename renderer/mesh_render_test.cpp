@@ -307,6 +307,65 @@ TEST(Texture, TgaWrittenByOiioSamplesTheHandWorkedTexels) {
   expect_hand_worked_tga_lookups(load_texture(file));
 }
 
+// Textures keep an 8- or 16-bit file's own values (issue 15: a 16384^2 1-bit
+// PNG took 1.24 GB as floats). Every level, grey and RGB, must read back bit
+// for bit as OpenImageIO's own float conversion of the same file gives it.
+TEST(Texture, EightAndSixteenBitTexelsAreOiiosFloatsBitForBit) {
+  const auto dir = temp_dir();
+  for (const int bits : {8, 16})
+    for (const int nch : {1, 2, 3, 4}) {
+      const int w = bits == 8 ? 256 : 1024, h = bits == 8 ? 1 : 64;  // every 8-bit level; 65536 16-bit ones
+      const auto file = dir / ("levels-" + std::to_string(bits) + "-" + std::to_string(nch) + ".png");
+      std::vector<std::uint16_t> v16(std::size_t(w) * h * nch);
+      std::vector<std::uint8_t> v8(v16.size());
+      for (std::size_t i = 0; i < v16.size(); ++i) {
+        const std::size_t px = i / std::size_t(nch), c = i % std::size_t(nch);
+        v16[i] = std::uint16_t(px * 1 + c * 7919);  // all levels over the pixels, channels differing
+        v8[i] = std::uint8_t(px + c * 51);
+      }
+      auto out = OIIO::ImageOutput::create(file.string());
+      ASSERT_TRUE(out);
+      const OIIO::TypeDesc td = bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16;
+      ASSERT_TRUE(out->open(file.string(), OIIO::ImageSpec(w, h, nch, td))) << out->geterror();
+      ASSERT_TRUE(out->write_image(td, bits == 8 ? static_cast<const void*>(v8.data()) : v16.data()));
+      ASSERT_TRUE(out->close());
+      const Texture t = load_texture(file);
+      EXPECT_EQ(bits == 8 ? t.u8.size() : t.u16.size(), std::size_t(w) * h * (nch >= 3 ? 3 : 1)) << file;
+      EXPECT_TRUE(t.rgb.empty()) << "no float copy";
+      std::vector<float> ref(std::size_t(w) * h * nch);
+      auto in = OIIO::ImageInput::open(file.string());
+      ASSERT_TRUE(in);
+      ASSERT_TRUE(in->read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, ref.data()));
+      int wrong = 0;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const Vec3d got = t.texel(x, y);
+          const float* r = &ref[(std::size_t(y) * w + x) * nch];
+          const float want[3] = {r[0], nch >= 3 ? r[1] : r[0], nch >= 3 ? r[2] : r[0]};
+          for (int c = 0; c < 3; ++c) wrong += got[c] != double(want[c]);
+        }
+      EXPECT_EQ(wrong, 0) << file;
+    }
+}
+
+// The PNM checks (issue 15: maxval 0, samples above maxval) refuse nothing
+// that is valid: comments anywhere, samples equal to the maxval, packed
+// lines, and a PFM's negative (little-endian) scale.
+TEST(Texture, ValidPnmAndPfmTexturesStillLoad) {
+  const auto dir = temp_dir();
+  std::ofstream(dir / "a.ppm") << "P3\n# made by hand\n2 1 # size\n15\n15 0 7\n# a comment between samples\n0 15 15 # end\n";
+  const Texture a = load_texture(dir / "a.ppm");
+  EXPECT_EQ(a.texel(0, 0).x, 1.0);
+  EXPECT_EQ(a.texel(1, 0).y, 1.0);
+  std::ofstream(dir / "b.pgm") << "P2 2 1 65535 65535 0\n";
+  EXPECT_NEAR(load_texture(dir / "b.pgm").texel(0, 0).x, 1.0, 1e-4);  // OIIO reads 65535 as 65534/65535
+  std::string pfm = "PF\n1 1\n-1.0\n";
+  const float px[3] = {0.25f, 0.5f, 2.0f};
+  pfm.append(reinterpret_cast<const char*>(px), sizeof px);
+  std::ofstream(dir / "c.pfm", std::ios::binary) << pfm;
+  EXPECT_EQ(load_texture(dir / "c.pfm").texel(0, 0).z, 2.0);
+}
+
 // The same texels in a TGA written byte by byte the way most tools write
 // it: uncompressed true-colour (type 2), BGR, origin at the BOTTOM left
 // (descriptor bit 5 clear), so the file holds the bottom row first.

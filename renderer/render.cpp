@@ -20,6 +20,7 @@
 #include "scene/camera.h"
 #include "errors.h"
 #include "huge_pages.h"
+#include "memory_budget.h"
 #include "methods/moller_simd.h"
 #include "pov_mesh.h"
 #include "registry.h"
@@ -133,13 +134,35 @@ struct Tracer::Impl {
 
   // Loads a material's images once, before any thread renders.
   void load_textures(const Material& m) {
-    if (m.texture) textures.load(m.texture->file);
+    if (m.texture) load_named(m.texture->file, m.texture->named_at);
     if (m.bump) {
-      const Texture& img = textures.load(m.bump->file);
+      const Texture& img = load_named(m.bump->file, m.bump->named_at);
       if (m.bump->variant == BumpVariant::height) {
         const std::string key = m.bump->file.lexically_normal().string();
-        if (!derivatives.count(key)) derivatives.emplace(key, height_derivatives(img));
+        if (!derivatives.count(key)) {
+          // 3 floats a texel, whatever the image's own size a texel.
+          const std::uint64_t need = std::uint64_t(img.width) * std::uint64_t(img.height) * 3 * sizeof(float);
+          if (need > available_memory())
+            throw InputError(located(m.bump->file.string(), 0, "height bump map of " + std::to_string(img.width) + "x" +
+                                                                   std::to_string(img.height) + " needs " +
+                                                                   std::to_string(need >> 20) +
+                                                                   " MB for its derivatives: not enough memory"));
+          derivatives.emplace(key, height_derivatives(img));
+        }
       }
+    }
+  }
+
+  // An image an MTL names: its errors name the MTL's line and the name as
+  // written there ("m.mtl:7: map_Kd 'tex.png': cannot read texture: not an
+  // image (a text file)"), not only the resolved path.
+  const Texture& load_named(const std::filesystem::path& file, const std::string& named_at) {
+    try {
+      return textures.load(file);
+    } catch (const InputError& e) {
+      if (named_at.empty()) throw;
+      const std::string what = e.what(), path = file.string();
+      throw InputError(named_at + (what.rfind(path, 0) == 0 ? what.substr(path.size()) : ": " + what));
     }
   }
 

@@ -14,6 +14,7 @@
 #include "audit.h"
 #include "errors.h"
 #include "io/input_file.h"
+#include "io/text_lines.h"
 
 namespace ra::audit {
 
@@ -85,9 +86,8 @@ std::vector<UserCase> read_cases_csv(const std::string& path) {
 std::vector<std::string> read_csv_header(std::istream& in, const std::string& path, long& lineno) {
   std::string line;
   std::vector<std::string> header;
-  while (header.empty() && std::getline(in, line)) {
+  while (header.empty() && read_text_line(in, line)) {
     ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     check_header_encoding(path, lineno, line);
     if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
   }
@@ -117,9 +117,8 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
     if (header[i] == "id") id_col = int(i);
 
   long row = 0;
-  while (std::getline(in, line)) {
+  while (read_text_line(in, line)) {
     ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     ++row;
     const auto f = split_fields(line);

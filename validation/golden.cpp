@@ -11,6 +11,7 @@
 #include "errors.h"
 #include "io/input_file.h"
 #include "io/json_input.h"
+#include "registry.h"
 #include "render.h"
 #include "scene/scene_mesh.h"
 
@@ -136,6 +137,52 @@ std::string entry_problem(const GoldenEntry& e) {
   return "";
 }
 
+// The render settings a golden records, checked as `render` checks its
+// flags (a manifest's spp of 2 was rendered at 1, a wrong method name
+// failed later naming no manifest): "" or the problem; *key names the
+// setting.
+std::string settings_problem(const json& s, std::string* key) {
+  if (!s.is_object()) return *key = "", "settings must be an object";
+  auto text = [&](const char* k, std::string& v) {
+    *key = k;
+    if (!s.contains(k)) return true;
+    if (!s.at(k).is_string()) return false;
+    v = s.at(k).get<std::string>();
+    return true;
+  };
+  std::string v;
+  for (auto [k, kind] : {std::pair{"triangle_method", Kind::triangle}, {"sphere_method", Kind::sphere}}) {
+    v.clear();
+    if (!text(k, v)) return "expected a string";
+    const Method* m = v.empty() ? nullptr : find_method(v);
+    if (s.contains(k) && (!m || m->kind != kind))
+      return "unknown " + std::string(kind == Kind::triangle ? "triangle" : "sphere") + " method \"" + v +
+             "\"; valid: " + method_names(kind);
+  }
+  v.clear();
+  if (!text("precision", v)) return "expected a string";
+  if (s.contains("precision") && v != "float" && v != "double") return "precision must be float or double, got \"" + v + "\"";
+  v.clear();
+  if (!text("self_intersection", v)) return "expected a string";
+  if (s.contains("self_intersection") && !parse_self_intersection(v))
+    return "unknown self_intersection \"" + v + "\"";
+  v.clear();
+  if (!text("accel", v)) return "expected a string";
+  if (s.contains("accel") && !parse_accel(v)) return "unknown accel \"" + v + "\"";
+  *key = "spp";
+  if (s.contains("spp")) {
+    const json& n = s.at("spp");
+    if (!n.is_number_integer()) return "spp must be an integer";
+    const long long spp = n.get<long long>();
+    bool square = false;
+    for (long long a = 1; a <= 16; ++a) square = square || a * a == spp;
+    if (!square)
+      return "spp must be a square number of samples per pixel (1, 4, 9, ... 256) as for render --spp, got " +
+             std::to_string(spp);
+  }
+  return "";
+}
+
 // Which inputs differ between what was blessed and what is there now.
 std::string changed_inputs(const std::map<std::string, std::string>& then,
                            const std::map<std::string, std::string>& now) {
@@ -207,13 +254,15 @@ std::string combined_hash(const std::map<std::string, std::string>& inputs) {
 GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
   const fs::path m = root_ / "golden" / "manifest.json";
   if (!fs::exists(m)) return;
-  const json j = read_json_file(m.string());  // FILE:LINE errors, duplicate keys refused
+  JsonLines lines;  // every error names its line
+  const json j = read_json_file(m.string(), &lines);  // FILE:LINE errors, duplicate keys refused
   try {
     if (!j.is_object() || !j.contains("goldens") || !j.at("goldens").is_array())
-      throw InputError(m.string() + ": expected an object with a \"goldens\" array");
+      throw InputError(located(m.string(), lines.at("/goldens"), "expected an object with a \"goldens\" array"));
     const json& all = j.at("goldens");
     for (std::size_t i = 0; i < all.size(); ++i) {
-      const std::string at = m.string() + ": /goldens/" + std::to_string(i);
+      const std::string ptr = "/goldens/" + std::to_string(i);
+      const std::string at = located(m.string(), lines.at(ptr), ptr);
       if (!all[i].is_object()) throw InputError(at + ": expected an object");
       GoldenEntry g;
       try {
@@ -222,12 +271,23 @@ GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
         throw InputError(at + ": " + json_error_text(e));
       }
       if (const std::string why = entry_problem(g); !why.empty()) throw InputError(at + ": " + why);
+      std::string key;
+      if (const std::string why = settings_problem(g.settings, &key); !why.empty()) {
+        const std::string sp = ptr + "/settings" + (key.empty() ? "" : "/" + key);
+        throw InputError(located(m.string(), lines.at(sp), sp + ": " + why));
+      }
       if (entries_.count(g.name)) throw InputError(at + ": golden \"" + g.name + "\" listed twice");
       entries_[g.name] = g;
     }
   } catch (const json::exception& e) {
     throw InputError(m.string() + ": " + json_error_text(e));
   }
+}
+
+std::vector<std::filesystem::path> GoldenSet::inputs_of(const std::string& name) const {
+  std::vector<fs::path> out{root_ / "scenes" / (name + ".json")};
+  if (auto it = entries_.find(name); it != entries_.end()) out.push_back(root_ / it->second.image);
+  return out;
 }
 
 std::vector<std::string> GoldenSet::all_names() const {
@@ -299,13 +359,12 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
   return {false, msg};
 }
 
-std::string GoldenSet::bless(const std::string& name) {
+std::string GoldenSet::bless(const std::string& name, OutputBatch* batch) {
   const fs::path scene_file = root_ / "scenes" / (name + ".json");
   if (!fs::exists(scene_file)) {
     auto it = entries_.find(name);
     if (it == entries_.end()) throw InputError(scene_file.string() + ": no such scene");
-    std::error_code ec;
-    fs::remove(root_ / it->second.image, ec);
+    to_remove_.push_back(root_ / it->second.image);  // when the manifest is saved
     entries_.erase(it);
     removed_ = true;
     return name + ": removed (its scene is gone)";
@@ -351,12 +410,15 @@ std::string GoldenSet::bless(const std::string& name) {
   }
   std::error_code ec;
   fs::create_directories((root_ / g.image).parent_path(), ec);
-  if (write_png) write_image(root_ / g.image, img, {8, false});
+  if (write_png) {
+    if (batch) batch->add_replacement(root_ / g.image);
+    write_image(root_ / g.image, img, {8, false});
+  }
   entries_[name] = g;
   return what;
 }
 
-void GoldenSet::save() const {
+void GoldenSet::save(OutputBatch* batch) const {
   json all = json::array();
   for (const auto& [n, e] : entries_) all.push_back(to_json(e));
   json j = {{"about", "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
@@ -364,7 +426,10 @@ void GoldenSet::save() const {
             {"goldens", all}};
   std::error_code ec;
   fs::create_directories(root_ / "golden", ec);
-  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2) + "\n");
+  if (batch) batch->add_replacement(root_ / "golden" / "manifest.json");
+  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (batch) batch->commit();  // the images and the manifest together
+  for (const auto& f : to_remove_) fs::remove(f, ec);
 }
 
 }  // namespace ra

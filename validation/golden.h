@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "image_compare.h"
+#include "io/atomic_file.h"
 #include "scene/scene.h"
 
 namespace ra {
@@ -49,6 +50,9 @@ class GoldenSet {
 
   // Scene names: scenes/*.json stems, and any entries whose scene is gone.
   std::vector<std::string> all_names() const;
+  const std::filesystem::path& root() const { return root_; }
+  // The files check(name) reads before any other: its scene and golden image.
+  std::vector<std::filesystem::path> inputs_of(const std::string& name) const;
 
   struct Result {
     bool pass = false;
@@ -60,13 +64,16 @@ class GoldenSet {
 
   // Renders `name` and records it; returns a line saying what changed.
   // save() writes the manifest.
-  std::string bless(const std::string& name);
-  void save() const;
+  // With `batch`, the image and (save) the manifest are staged in it: a
+  // later failure leaves golden/ as it was (commit() renames them).
+  std::string bless(const std::string& name, OutputBatch* batch = nullptr);
+  void save(OutputBatch* batch = nullptr) const;
 
  private:
   std::filesystem::path root_;
   std::map<std::string, GoldenEntry> entries_;
   bool removed_ = false;
+  std::vector<std::filesystem::path> to_remove_;  // goldens of removed scenes: deleted by save()
 };
 
 }  // namespace ra

@@ -13,6 +13,7 @@
 #include "cases_csv.h"
 #include "errors.h"
 #include "io/input_file.h"
+#include "io/text_lines.h"
 
 namespace ra::audit {
 
@@ -49,9 +50,8 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
     if (c < 0) throw InputError(located(path, lineno, std::string("missing column '") + name + "' (need id,hit,t)"));
 
   std::unordered_map<std::string, Given> out;
-  while (std::getline(in, line)) {
+  while (read_text_line(in, line)) {  // \n, \r\n and a lone \r
     ++lineno;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     const auto f = split_fields(line);
     if (f.size() != header.size())

@@ -252,10 +252,7 @@ void copy_pov_image(const std::filesystem::path& source, const std::filesystem::
   // Read first as a texture is: its header size bounded by the file, a
   // truncated file an error of one line (libpng's own lines kept off
   // stderr), before the module's copy trusts it (issue 15's third pass).
-  {
-    int w = 0, h = 0, nc = 0;
-    read_pixels(source, "texture", w, h, nc);
-  }
+  read_stored_pixels(source, "texture");  // its own 8 or 16 bits: not 4 bytes a channel
   std::vector<unsigned char> png;
   std::string err;
   switch (image_module::api().rgb_png(source.c_str(), &png, &err)) {

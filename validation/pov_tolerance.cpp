@@ -34,6 +34,9 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
     // Sizes and pixel coordinates inside the render limit (a pixel at x -1
     // was accepted and never matched; 3e9 wrapped round as an int).
     auto side = [&](const nlohmann::json& v, const std::string& where, long long lo, long long hi) {
+      // An unsigned 2^63 read as long long was quoted as -2^63: the file's own text.
+      if (v.is_number_unsigned() && v.get<unsigned long long>() > (unsigned long long)hi)
+        throw InputError(where + ": " + v.dump() + " is outside " + std::to_string(lo) + ".." + std::to_string(hi));
       const long long x = v.get<long long>();
       if (x < lo || x > hi)
         throw InputError(where + ": " + std::to_string(x) + " is outside " + std::to_string(lo) + ".." + std::to_string(hi));

@@ -238,3 +238,76 @@ put('scene', 'camera_1e308.json', '{"camera": {"position": [1e308, 0, 5]}, "obje
 put('scene', 'radius_denormal.json', '{"objects": [{"sphere": {"radius": 1e-320}}]}\n')
 put('scene', 'adc_bailout_negative.json', '{"adc_bailout": -1, "objects": [{"sphere": {"radius": 1}}]}\n')
 put('scene', 'mesh_is_json.json', '{"objects": [{"mesh": "mesh_is_json.json"}]}\n')
+
+# Fourth pass (issue 15): what the magic or the counts promise; header
+# errors at their header line; CR-only line ends counted as line ends.
+put('off', 'noff_without_normals.off', 'NOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'coff_without_colours.off', 'COFF\n3 1 0\n0 0 0 1 1 1 1\n1 0 0\n0 1 0 1 1 1 1\n3 0 1 2\n')
+put('off', 'cnoff_colour_only.off', 'CNOFF\n3 1 0\n0 0 0 0 0 1 1 1 1\n1 0 0 1 1 1\n0 1 0 0 0 1 1 1 1\n3 0 1 2\n')
+put('off', 'fewer_faces.off', 'OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'fewer_vertices.off', 'OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n')
+put('off', 'counts_without_edges.off', 'OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'cr_only_line_ends.off', 'OFF\r3 1 0\r0 0 0\r1 0 0\r0 1 0\r3 0 1 x\r')
+put('ply', 'face_without_vertex_indices.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int idx\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'cr_only_line_ends.ply', 'ply\rformat ascii 1.0\relement vertex 3\rproperty float x\rproperty float y\rproperty float z\rend_header\r0 0 0\r1 0 0\r0 q 0\r')
+# `l` and `p` are not rendered, but their indices are checked like a face's.
+put('obj', 'l_index_past_end.obj', TRI + 'f 1 2 3\nl 1 2 9\n')
+put('obj', 'l_index_zero.obj', TRI + 'l 0 1\nf 1 2 3\n')
+put('obj', 'p_relative_too_far.obj', TRI + 'f 1 2 3\np -4\n')
+put('obj', 'l_texture_past_end.obj', TRI + 'vt 0 0\nf 1 2 3\nl 1/1 2/2\n')
+put('obj', 'l_one_vertex.obj', TRI + 'f 1 2 3\nl 1\n')
+# CR-only line ends (classic Mac OS) are line ends: errors at the right line.
+put('scene', 'cr_only_line_ends.json', '{\r"width": 8,\r"height": 8,\r"objects": [}\r')
+put('csv', 'cr_only_line_ends.csv', 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\r0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\r0,0,x,0,0,1,0,0,1,1,0,1,0,1,1\r')
+put('csv', 'mixed_line_ends.csv', 'ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\r\n0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\r0,0,0,0,0,1,0,0,1,1,0,1,0,1,1\n0,0,0,0,0,1,0,0,1,1,0,1,0,1\r\n')
+# The settings a golden records are checked as render checks its flags, at their line.
+GS = '{\n  "goldens": [\n    {\n      ' + GE + '"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": 8, "height": 8,\n      "settings": {\n        "triangle_method": "moller",\n        "spp": %s\n      }\n    }\n  ]\n}\n'
+put('golden', 'spp_2.json', GS % '2')
+put('golden', 'spp_huge.json', GS % '1000000')
+put('golden', 'triangle_method_unknown.json', GS.replace('"moller"', '"mollerr"') % '1')
+# Textures OIIO's readers accepted silently, and files that are no image:
+# refused in our words (via a scene, map_Kd and bump).
+put('texture', 'png_without_iend.png', good[:good.rindex(b'IEND') - 4])
+put('texture', 'ppm_maxval_0.ppm', b'P6\n2 2\n0\n' + b'\x00' * 12)
+put('texture', 'p3_maxval_0.ppm', 'P3\n# a comment\n2 2\n0\n0 0 0 0 0 0 0 0 0 0 0 0\n')
+put('texture', 'obj_as_texture.png', TRI + 'f 1 2 3\n')
+put('texture', 'random_bytes.bin', bytes((i * 7919 + 13) % 251 for i in range(2000)))
+put('mtl', 'map_kd_names_itself.mtl', 'newmtl a\nmap_Kd map_kd_names_itself.mtl\n')
+put('mtl', 'bump_names_an_obj.mtl', 'newmtl a\nbump ../obj/v_word.obj\n')
+put('mtl', 'map_bump_empty_file.mtl', 'newmtl a\nmap_bump ../texture/zero_bytes.png\n')
+put('mtl', 'map_kd_png_without_iend.mtl', 'newmtl a\nKd 1 1 1\nmap_Kd ../texture/png_without_iend.png\n')
+put('mtl', 'bump_ppm_maxval_0.mtl', 'newmtl a\nbump -bm 2 ../texture/ppm_maxval_0.ppm\n')
+put('golden', 'deep_nesting.json', '{"goldens": ' + '[' * 100000 + '\n')
+# Second hostile pass (HOSTILE2 F14-F16): PLY/OFF data the header does not
+# declare, an element twice, a float beyond float, counts beyond three.
+PLY3 = 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1
+put('ply', 'element_twice.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1 + '0 0 0\n1 0 0\n0 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'float_1e39.ply', PLY3 + '1e39 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('ply', 'trailing_line.ply', PLY3 + '0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n1 2 3\n')
+put('ply', 'bin_trailing_bytes.ply', PLY3.replace('ascii', 'binary_little_endian').encode() + struct.pack('<9f', 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack('<B3i', 3, 0, 1, 2) + b'garbage')
+put('ply', 'bin_uint_index_2p32.ply', PLY3.replace('ascii', 'binary_little_endian').replace('uchar int', 'uchar uint').encode() + struct.pack('<9f', 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack('<B3I', 3, 0, 1, 2**32 - 1))
+put('ply', 'format_after_element.ply', 'ply\nelement vertex 3\nformat ascii 1.0\nend_header\n')
+put('ply', 'two_index_lists.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nproperty list uchar int vertex_index\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 3 0 1 2\n')
+put('off', 'trailing_face.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n')
+put('off', 'vertex_extra_values.off', 'OFF\n3 1 0\n0 0 0 9 9\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'four_counts.off', 'OFF\n3 1 0 7\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
+put('off', 'face_word_after_indices.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 xyz\n')
+# Second hostile pass (HOSTILE2 F8-F11): sizes OIIO's GIF reader allocated in
+# open(), PNM/PFM values out of range, non-finite texels, a GIF without image.
+put('texture', 'gif_16384_in_35_bytes.gif', b'GIF89a\x00\x40\x00\x40\x80\x00\x00\x00\x00\x00\xff\xff\xff,\x00\x00\x00\x00\x00\x40\x00\x40\x00\x02\x02\x44\x01\x00;')
+put('texture', 'gif_without_image.gif', b'GIF89a\x04\x00\x04\x00\x00\x00\x00;')
+put('texture', 'ppm_maxval_65536.ppm', b'P6\n2 2\n65536\n' + b'\x00' * 24)
+put('texture', 'ppm_maxval_negative.ppm', b'P6\n2 2\n-1\n' + b'\x00' * 24)
+put('texture', 'p3_sample_above_maxval.ppm', 'P3\n2 2\n255\n0 0 0\n999 0 0 0 0 0 0 0 0\n')
+put('texture', 'p2_negative_sample.pgm', 'P2\n2 2\n15\n-5 0 0 0\n')
+put('texture', 'pbm_bit_2.pbm', 'P1\n2 2\n0 2 0 1\n')
+put('texture', 'pfm_scale_0.pfm', b'PF\n2 2\n0\n' + struct.pack('<f', 1.0) * 12)
+put('texture', 'pfm_nan_texel.pfm', b'PF\n2 2\n-1.0\n' + struct.pack('<f', 0.5) * 3 + struct.pack('<f', float('nan')) * 9)
+# HOSTILE2 F21, F23: the file's own number quoted; a directory named as such.
+put('tolerance', 'pixel_x_2p63.json', '{"width": 8, "height": 8, "pixels": [{"x": 9223372036854775808, "y": 1, "levels": 1, "cause": "c"}]}\n')
+put_dir('tolerance', 'is_a_directory.json')
+# PNM data shorter than the header promises (OIIO: "unreadable or
+# unsupported image", or the rest read as black).
+put('texture', 'p6_truncated.ppm', b'P6\n2 2\n255\n' + b'\x00' * 7)
+put('texture', 'p3_truncated.ppm', 'P3\n2 2\n255\n1 2 3\n')
+put('tolerance', 'width_not_the_images.json', '{"width": 16, "height": 16, "pixels": []}\n')

@@ -80,6 +80,9 @@ struct MtlMaterial {
   double Ns = 0, Ni = 1, d = 1;  // d: opacity; `Tr t` sets d = 1 - t unless `d` is given
   int illum = 2;
   std::string map_Ka, map_Kd, map_Ks, map_d, map_bump;
+  // Where map_Kd and map_bump were named ("m.mtl:7: map_Kd 'tex.png'"), for errors
+  // met when the image is read later.
+  std::string map_Kd_at, map_bump_at;
   double bump_multiplier = 1;  // `-bm` of the bump map
 };
 

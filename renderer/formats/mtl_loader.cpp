@@ -12,10 +12,13 @@
 //   Backslashes become '/', relative names are resolved against the .mtl's
 //   directory, a missing file is a warning.
 // - Statements before the first newmtl, unknown ones and `newmtl` without
-//   a name (Blender writes it; the material is named "") are warnings.
+//   a name are warnings. The last stays accepted, as the material named "":
+//   Blender writes `newmtl ` with `usemtl ` (the assimp test model
+//   empty_mat.obj), so refusing it would refuse real exporter output.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <unordered_set>
 
 #include "mesh.h"
 #include "../io/file_identity.h"
@@ -48,10 +51,18 @@ struct MtlParser {
   Where w{&name};
   std::vector<MtlMaterial> out;
   std::vector<bool> has_d;
-  std::vector<std::string> unknown;
+  std::unordered_set<std::string> unknown;  // a set: distinct unknown statements were a quadratic scan
+  CappedWarnings missing{warnings, name, "more textures not found"};
+  CappedWarnings early{warnings, name, "more statements before the first newmtl ignored"};
+  CappedWarnings unsupported{warnings, name, "more unsupported MTL statements ignored"};
 
   MtlParser(const std::string& n, const std::filesystem::path& b, bool check, std::vector<std::string>& warn)
       : name(n), base(b), check_files(check), warnings(warn) {}
+  void finish() {
+    missing.finish();
+    early.finish();
+    unsupported.finish();
+  }
 
   bool kw(const char* k, const char* kend, const char* word) { return is_kw(k, kend, upper(word).c_str()); }
 
@@ -85,7 +96,8 @@ struct MtlParser {
     return ec == std::errc() && at_separator(q, se);
   }
 
-  void map(std::string& dst, const char* p, const char* se, long line, bool bump) {
+  void map(std::string& dst, const char* p, const char* se, long line, bool bump, std::string* at = nullptr,
+           std::string_view keyword = {}) {
     MtlMaterial& m = out.back();
     for (;;) {
       p = skip_ws(p, se);
@@ -127,13 +139,14 @@ struct MtlParser {
     std::filesystem::path path(file);
     if (path.is_relative()) path = (base / path).lexically_normal();
     dst = path.string();
+    if (at) *at = located(name, line, std::string(keyword) + " '" + file + "'");
     // Missing: a warning (the material renders without it). Anything else
     // that is not a file (a directory, a FIFO, a symlink loop) is an error
     // here, naming this line, not later as a bare path or a library text.
     if (!check_files) return;
     const std::string why = input_file_problem(path);
     if (why == "no such file")
-      warnings.push_back(located(name, line, "texture '" + file + "' not found (" + dst + ")"));
+      missing.add(line, located(name, line, "texture '" + file + "' not found (" + dst + ")"));
     else if (!why.empty())
       w.fail(line, "texture '" + file + "': " + why + " (" + dst + ")");
     else
@@ -154,7 +167,7 @@ struct MtlParser {
       return;
     }
     if (out.empty()) {
-      warnings.push_back(located(name, line, "statement before the first newmtl ignored"));
+      early.add(line, located(name, line, "statement before the first newmtl ignored"));
       return;
     }
     MtlMaterial& m = out.back();
@@ -180,15 +193,12 @@ struct MtlParser {
       return;
     }
     if (kw(k, p, "map_Ka")) return map(m.map_Ka, p, se, line, false);
-    if (kw(k, p, "map_Kd")) return map(m.map_Kd, p, se, line, false);
+    if (kw(k, p, "map_Kd")) return map(m.map_Kd, p, se, line, false, &m.map_Kd_at, {k, size_t(p - k)});
     if (kw(k, p, "map_Ks")) return map(m.map_Ks, p, se, line, false);
     if (kw(k, p, "map_d")) return map(m.map_d, p, se, line, false);
-    if (kw(k, p, "map_bump") || kw(k, p, "bump")) return map(m.map_bump, p, se, line, true);
+    if (kw(k, p, "map_bump") || kw(k, p, "bump")) return map(m.map_bump, p, se, line, true, &m.map_bump_at, {k, size_t(p - k)});
     const std::string key(k, p);
-    if (std::find(unknown.begin(), unknown.end(), key) == unknown.end()) {
-      unknown.push_back(key);
-      warnings.push_back(located(name, line, "unsupported MTL statement '" + key + "' ignored"));
-    }
+    if (unknown.insert(key).second) unsupported.add(line, located(name, line, "unsupported MTL statement '" + key + "' ignored"));
   }
 };
 
@@ -209,6 +219,7 @@ std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& nam
     line += extra + 1;
     p = se + 1;
   }
+  parser.finish();
   return std::move(parser.out);
 }
 

@@ -90,6 +90,22 @@ TEST(Mtl, WarningsAndErrors) {
   EXPECT_EQ(error_of("newmtl a\nmap_Kd -s 1 1 1\n"), "m.mtl:2: texture statement without a file name");
 }
 
+// Issue 15 (HOSTILE2 F24): a flood of one kind of warning is ten lines and
+// a count, and distinct unknown statements are found in linear time.
+TEST(Mtl, WarningsOfOneKindAreTenLinesAndACount) {
+  std::string text;
+  for (int i = 0; i < 12; ++i) text += "Kd 1 1 1\n";
+  text += "newmtl a\n";
+  for (int i = 0; i < 20000; ++i) text += "zz" + std::to_string(i) + " 1\n";
+  std::vector<std::string> w;
+  parse(text, &w);
+  ASSERT_EQ(w.size(), 22u);
+  EXPECT_EQ(w[10], "m.mtl:14: unsupported MTL statement 'zz0' ignored");
+  EXPECT_EQ(w[20], "m.mtl:11: 2 more statements before the first newmtl ignored");
+  EXPECT_EQ(w[0], "m.mtl:1: statement before the first newmtl ignored");
+  EXPECT_EQ(w[21], "m.mtl:24: 19990 more unsupported MTL statements ignored");
+}
+
 TEST(Mtl, MissingTextureIsAWarningWithTheLine) {
   test::TempDir d;
   d.write("present.png", "x");

@@ -42,6 +42,7 @@
 #include <string>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -385,6 +386,7 @@ struct ChunkParser {
   long iv = 0, ivt = 0, ivn = 0;  // statements of each kind seen so far in the chunk
   long itri = 0;                   // triangles written (parallel)
   const char* here = nullptr;      // statement being parsed (serial: capacity estimates)
+  const char* stmt = "face";       // the statement whose indices are parsed, for messages
   std::vector<Corner> poly;
   std::vector<Vec3d> pts;
   std::vector<std::array<int, 3>> ears;
@@ -595,8 +597,8 @@ struct ChunkParser {
       case Kw::VN: parse_vn(kend, se, line); return;
       case Kw::F: parse_f(kend, se, line); return;
       case Kw::VP: ++c.vp; return;
-      case Kw::L: ++c.l; return;
-      case Kw::P: ++c.p; return;
+      case Kw::L: parse_lp(kend, se, line, "line", 2), ++c.l; return;
+      case Kw::P: parse_lp(kend, se, line, "point", 1), ++c.p; return;
       case Kw::O: c.cur_object = parse_name(c.objects, kend, se, line), tags_changed = true; return;
       case Kw::Usemtl: c.cur_mat = parse_name(c.mats, kend, se, line); return;
       case Kw::G: c.cur_group = parse_group(kend, se, line), tags_changed = true; return;
@@ -679,7 +681,7 @@ struct ChunkParser {
       // then passed and read before the first vertex; issue 15).
       if (i < -static_cast<long long>(count))
         w.fail(line, std::string("relative ") + kind + " index " + std::to_string(i) +
-                         " reaches before the first one (" + std::to_string(count) + " defined before this face)");
+                         " reaches before the first one (" + std::to_string(count) + " defined before this " + stmt + ")");
       out = int(count + i);
     }
     return q;
@@ -703,7 +705,7 @@ struct ChunkParser {
       if (read_keyword(s, e, &kend) == want && ++n == i)
         w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is defined later, at line " +
                          std::to_string(ln) + ": forward references are not allowed (" + std::to_string(count) +
-                         " defined before this face)");
+                         " defined before this " + stmt + ")");
       ln += extra + 1;
       p = e + 1;
     }
@@ -711,6 +713,27 @@ struct ChunkParser {
     const char* single = kind[0] == 'v' ? " vertex" : kind[0] == 't' ? " texture coordinate" : " normal";
     w.fail(line, std::string(kind) + " index " + std::to_string(i) + " is past the end: the file has only " +
                      std::to_string(n) + (n == 1 ? single : plural));
+  }
+
+  // `l v1[/vt1] v2[/vt2] ...` and `p v1 v2 ...`: not rendered, but their
+  // indices are checked as a face's are (an index past the end or 0 was
+  // skipped silently). `what` names the statement, `min` its fewest vertices.
+  void parse_lp(const char* p, const char* se, long line, const char* what, int min) {
+    const long nv = c.base_v + iv, nvt = c.base_vt + ivt;
+    stmt = what;
+    int n = 0, unused = 0;
+    for (;;) {
+      p = skip_ws(p, se);
+      if (p >= se || *p == '#') break;
+      p = parse_index(p, se, nv, "vertex", line, unused);
+      if (what[0] == 'l' && p < se && *p == '/') p = parse_index(p + 1, se, nvt, "texture", line, unused);
+      if (!at_separator(p, se)) w.fail(line, "malformed " + std::string(what) + " vertex near '" + token_text(p, se) + "'");
+      ++n;
+    }
+    stmt = "face";
+    if (n < min)
+      w.fail(line, std::string(what) + " statement with " + std::to_string(n) + " vertices (at least " +
+                       std::to_string(min) + " needed)");
   }
 
   void parse_f(const char* p, const char* se, long line) {
@@ -965,8 +988,9 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
   namespace fs = std::filesystem;
   if (opt.load_materials) {
     const fs::path dir = fs::path(m.path).parent_path();
-    std::vector<std::string> loaded;
+    std::unordered_set<std::string> loaded;  // a set: 50,000 mtllib lines were a quadratic scan
     std::unordered_map<std::string, int> defined;
+    objtext::CappedWarnings missing{m.warnings, m.path, "more material libraries not found or not files"};
     for (auto& [line, raw] : mtllibs) {
       std::vector<std::string> files;
       std::error_code ec;
@@ -987,11 +1011,10 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
       for (auto& f : files) {
         const fs::path file = dir / slashes(f);
         const std::string key = file.lexically_normal().string();
-        if (std::find(loaded.begin(), loaded.end(), key) != loaded.end()) continue;
-        loaded.push_back(key);
+        if (!loaded.insert(key).second) continue;
         if (const std::string why = input_file_problem(file); !why.empty()) {
-          m.warnings.push_back(located(m.path, line,
-                                       "material library '" + f + "' " +
+          missing.add(line, located(m.path, line,
+                                       "material library '" + short_quote(f) + "' " +
                                            (why == "no such file" ? std::string("not found") : why) +
                                            " (its materials get defaults)"));
           continue;
@@ -1006,7 +1029,9 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
         }
       }
     }
+    missing.finish();
   }
+  objtext::CappedWarnings undefined{m.warnings, m.path, "more materials not defined (default material used)"};
   std::unordered_map<std::string, int> byname;
   for (size_t i = 0; i < m.materials.size(); ++i) byname.emplace(m.materials[i].name, int(i));
   std::vector<int> map(used.names.size());
@@ -1017,8 +1042,8 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
       map[i] = it->second;
     } else {
       if (opt.load_materials)
-        m.warnings.push_back(located(m.path, used.lines[i],
-                                     "material '" + used.names[i] + "' is not defined (default material used)"));
+        undefined.add(used.lines[i], located(m.path, used.lines[i],
+                                             "material '" + short_quote(used.names[i]) + "' is not defined (default material used)"));
       MtlMaterial d;
       d.name = used.names[i];
       map[i] = int(m.materials.size());
@@ -1027,6 +1052,7 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
     }
     identity = identity && map[i] == int(i);
   }
+  undefined.finish();
   if (!identity)
     for (auto& t : m.triangles)
       if (t.material >= 0) t.material = map[size_t(t.material)];
@@ -1240,10 +1266,17 @@ std::string read_file_bytes(const std::filesystem::path& file, std::uint64_t max
                                  std::to_string(max_bytes)));
   std::ifstream f(file, std::ios::binary);
   if (!f) throw InputError(located(file.string(), 0, "cannot open"));
+  // Read to the end, whatever the size said: /proc files say 0 (and were
+  // read as empty), sysfs files 4096 (and were "read failed").
   std::string buf;
-  buf.resize(size_t(size));
-  f.read(buf.data(), std::streamsize(size));
-  if (size_t(f.gcount()) != size) throw InputError(located(file.string(), 0, "read failed"));
+  buf.reserve(size_t(size));
+  char chunk[65536];
+  while (f.read(chunk, sizeof chunk) || f.gcount() > 0) {
+    buf.append(chunk, size_t(f.gcount()));
+    if (buf.size() > max_bytes)
+      throw InputError(located(file.string(), 0, "file is more than the limit of " + std::to_string(max_bytes) + " bytes"));
+  }
+  if (f.bad()) throw InputError(located(file.string(), 0, "read failed: " + std::string(std::strerror(errno))));
   return buf;
 }
 
@@ -1257,6 +1290,9 @@ namespace {
 class FileBytes {
  public:
   FileBytes(const std::filesystem::path& file, std::uint64_t max_bytes) {
+    // Noted as an input on the mapped path too: crack-maps --mesh naming one
+    // of its own maps was overwritten (HOSTILE2 F22).
+    check_input_file(file);
     std::error_code ec;
     const auto size = std::filesystem::file_size(file, ec);
 #if defined(__unix__)

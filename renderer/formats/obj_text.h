@@ -11,11 +11,31 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "../errors.h"
 #include "mesh.h"
 
 namespace ra::objtext {
+
+// Warnings of one kind: the first ten one line each, the rest counted in
+// one line by finish() (issue 15: 50,000 missing mtllib files, undefined
+// materials or statements before newmtl printed 50,000 lines).
+struct CappedWarnings {
+  static constexpr long kShown = 10;
+  std::vector<std::string>& out;
+  std::string file;
+  std::string rest;  // "more material libraries not found"
+  long n = 0, first_line = 0;
+  void add(long line, std::string message) {
+    if (++n <= kShown) out.push_back(std::move(message));
+    else if (n == kShown + 1) first_line = line;
+  }
+  void finish() {
+    if (n > kShown) out.push_back(located(file, first_line, std::to_string(n - kShown) + " " + rest));
+    n = 0;
+  }
+};
 
 inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <unordered_set>
 
 #include "../io/atomic_file.h"
 #include "../errors.h"
@@ -21,12 +22,15 @@ struct Tokens {
   long line = 1;
 
   [[noreturn]] void fail(const std::string& msg) const { throw InputError(located(name, line, msg)); }
-  // Skips spaces (and newlines when `lines`), and '#' comments.
+  // A line ends at \n, \r\n or a lone \r (classic Mac OS): a CR-only file
+  // was one line, its errors all at line 1 (issue 15's fourth pass).
+  bool eol(const char* q) const { return *q == '\n' || (*q == '\r' && (q + 1 == e || q[1] != '\n')); }
+  // Skips spaces (and line ends when `lines`), and '#' comments.
   void skip(bool lines) {
     for (;;) {
-      while (p < e && (*p == ' ' || *p == '\t' || *p == '\r' || (lines && *p == '\n'))) line += (*p++ == '\n');
+      while (p < e && (*p == ' ' || *p == '\t' || (*p == '\r' && !eol(p)) || (lines && eol(p)))) line += eol(p++);
       if (p < e && *p == '#') {
-        while (p < e && *p != '\n') ++p;
+        while (p < e && !eol(p)) ++p;
         continue;
       }
       return;
@@ -34,10 +38,10 @@ struct Tokens {
   }
   bool at_eol() {
     skip(false);
-    return p >= e || *p == '\n';
+    return p >= e || eol(p);
   }
   void next_line() {
-    while (p < e && *p != '\n') ++p;
+    while (p < e && !eol(p)) ++p;
     if (p < e) ++p, ++line;
   }
   std::string_view word() {
@@ -45,6 +49,11 @@ struct Tokens {
     const char* b = p;
     while (p < e && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n') ++p;
     return {b, size_t(p - b)};
+  }
+  // True at the end of the text (after blank lines and comments).
+  bool at_end() {
+    skip(true);
+    return p >= e;
   }
   // The next number on this line (OFF's lines are records).
   template <class T>
@@ -86,11 +95,13 @@ struct PlyProp {
   PlyType type;
   bool list = false;
   PlyType count_type = PlyType::U8;
+  long line = 0;  // its header line, for errors about the property itself
 };
 struct PlyElement {
   std::string name;
   long count;
   std::vector<PlyProp> props;
+  long line = 0;  // its header line
 };
 
 bool ply_type(std::string_view s, PlyType& t) {
@@ -113,7 +124,8 @@ bool fits_ply_type(PlyType t, double v) {
     case PlyType::U16: return v >= 0 && v <= 65535 && v == std::floor(v);
     case PlyType::I32: return v >= -2147483648.0 && v <= 2147483647.0 && v == std::floor(v);
     case PlyType::U32: return v >= 0 && v <= 4294967295.0 && v == std::floor(v);
-    default: return true;  // float, double: any number the reader accepted
+    case PlyType::F32: return !std::isfinite(v) || std::fabs(v) <= 3.4028234663852886e38;  // 1e39 is no float (non-finite: said by the caller)
+    default: return true;  // double: any number the reader accepted
   }
 }
 
@@ -188,11 +200,13 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
   Tokens t{bytes.data(), bytes.data() + bytes.size(), name};
   if (t.word() != "ply") t.fail("not a PLY file (no 'ply' magic)");
   std::vector<PlyElement> elements;
+  std::unordered_set<std::string> prop_names;  // the current element's
   int format = -1;  // 0 ascii, 1 little, 2 big
   for (;;) {
     if (t.p >= t.e) t.fail("no end_header");
     const std::string_view k = t.word();
     if (k == "format") {
+      if (format >= 0 || !elements.empty()) t.fail(format >= 0 ? "a second format line" : "format line after an element");
       const auto f = t.word();
       format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
       if (format < 0) t.fail("unknown PLY format '" + std::string(f) + "'");
@@ -205,14 +219,20 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       t.next_line();
     } else if (k == "element") {
       PlyElement el;
+      el.line = t.line;
       el.name = std::string(t.word());
       el.count = t.number<long>("element count");
       if (el.count < 0 || el.count > (1L << 31)) t.fail("element count out of range");
+      if (!t.at_eol()) t.fail("unexpected '" + std::string(t.word().substr(0, 40)) + "' after the element count");
+      for (const auto& other : elements)  // was read as two elements, the rows concatenated
+        if (other.name == el.name) t.fail("element '" + el.name + "' given twice (first at line " + std::to_string(other.line) + ")");
       elements.push_back(std::move(el));
+      prop_names.clear();
       t.next_line();
     } else if (k == "property") {
       if (elements.empty()) t.fail("property before any element");
       PlyProp pr;
+      pr.line = t.line;
       auto ty = t.word();
       if (ty == "list") {
         pr.list = true;
@@ -221,8 +241,9 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       }
       if (!ply_type(ty, pr.type)) t.fail("unknown property type '" + std::string(ty) + "'");
       pr.name = std::string(t.word());
-      for (const auto& other : elements.back().props)  // was "vertex element without x, y, z" for x, x, z
-        if (other.name == pr.name) t.fail("property '" + pr.name + "' given twice in one element");
+      // Was "vertex element without x, y, z" for x, x, z. A set: comparing with
+      // every earlier property took 8.5 s for 80,000 of them (issue 15).
+      if (!prop_names.insert(pr.name).second) t.fail("property '" + pr.name + "' given twice in one element");
       if (pr.list && (pr.count_type == PlyType::F32 || pr.count_type == PlyType::F64))
         t.fail("list count type must be an integer type");
       elements.back().props.push_back(std::move(pr));
@@ -251,12 +272,20 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       if (n == "x") ix = int(i);
       if (n == "y") iy = int(i);
       if (n == "z") iz = int(i);
-      if (el.props[i].list && (n == "vertex_indices" || n == "vertex_index")) ilist = int(i);
+      if (el.props[i].list && (n == "vertex_indices" || n == "vertex_index")) {
+        if (is_face && ilist >= 0)
+          throw InputError(located(name, el.props[i].line, "a second vertex index list in the face element"));
+        ilist = int(i);
+      }
     }
-    if (is_vertex && (ix < 0 || iy < 0 || iz < 0)) t.fail("vertex element without x, y, z");
+    // Errors of the header name its line, not the first data line.
+    if (is_vertex && (ix < 0 || iy < 0 || iz < 0))
+      throw InputError(located(name, el.line, "vertex element without x, y, z"));
     for (int c : {ix, iy, iz})  // a list named x read its count as the coordinate
-      if (is_vertex && el.props[size_t(c)].list) t.fail("vertex property '" + el.props[size_t(c)].name + "' is a list");
-    if (is_face && ilist < 0) t.fail("face element without vertex_indices");
+      if (is_vertex && el.props[size_t(c)].list)
+        throw InputError(located(name, el.props[size_t(c)].line, "vertex property '" + el.props[size_t(c)].name + "' is a list"));
+    if (is_face && ilist < 0)
+      throw InputError(located(name, el.line, "face element without a vertex_indices (or vertex_index) list property"));
     // Reserve no more than the data can hold (a count alone is not trusted).
     if (is_vertex) m.positions.reserve(std::min(size_t(el.count), size_t(br.e - br.p) / min_row_bytes(el, format) + 1));
     for (long r = 0; r < el.count; ++r) {
@@ -282,8 +311,11 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
             const double v = value(pr.type);
             if (int(i) == ilist) {
               // NaN or a fraction is not an index (int(NaN) would read as -2147483648).
-              if (!(v >= -2147483648.0 && v <= 2147483647.0) || v != std::floor(v))
+              if (!(v == std::floor(v)))
                 fail("face " + std::to_string(r) + " has vertex index " + number_text(v) + ", not an integer");
+              if (!(v >= 0 && v < double(m.positions.size() + (vertices_read ? 0 : 2147483647.0))))
+                fail("face " + std::to_string(r) + " has vertex index " + number_text(v) + " out of range (" +
+                     (vertices_read ? std::to_string(m.positions.size()) + " vertices, from 0)" : "not a vertex index)"));
               m.indices.push_back(int(v));
             }
           }
@@ -315,6 +347,14 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
     }
     vertices_read = vertices_read || is_vertex;
   }
+  // Data after the declared rows was ignored (a count too low, or garbage).
+  if (format == 0) {
+    if (!t.at_end()) t.fail("data after the " + std::to_string(elements.empty() ? 0 : elements.back().count) +
+                            " rows the header declares for the last element");
+  } else if (br.p != br.e) {
+    throw InputError(located(name, 0, "byte " + std::to_string(br.p - br.b) + ": " + std::to_string(br.e - br.p) +
+                                          " bytes after the data the header declares"));
+  }
   check_faces(m, name);
   return m;
 }
@@ -330,6 +370,44 @@ static bool off_magic(std::string_view m) {
   return m.empty();
 }
 
+// What each vertex line carries after x y z, as the magic promises: N a
+// normal (3 values), C a colour (RGB or RGBA: 3 or 4), ST a texture
+// coordinate (2). A NOFF without its normals was read as a plain OFF.
+struct OffExtras {
+  int normal = 0, colour = 0, st = 0;
+};
+static OffExtras off_extras(std::string_view m) {
+  OffExtras x;
+  if (m.rfind("ST", 0) == 0) x.st = 2, m.remove_prefix(2);
+  if (!m.empty() && m[0] == 'C') x.colour = 3, m.remove_prefix(1);
+  if (!m.empty() && m[0] == 'N') x.normal = 3;
+  return x;
+}
+
+// The values after x y z on a vertex line: all numbers, and as many as the
+// magic promises (a colour may have 3 or 4). A plain OFF's extra values
+// are ignored as before (some files carry unannounced colours).
+static void check_off_extras(Tokens& t, const OffExtras& x, std::string_view magic) {
+  if (!x.normal && !x.colour && !x.st) {  // "0 0 0 9 9" was read as 0 0 0
+    if (!t.at_eol()) t.fail("unexpected '" + std::string(t.word().substr(0, 40)) + "' after x y z (a COFF, NOFF or STOFF magic announces more values)");
+    return;
+  }
+  int n = 0;
+  while (!t.at_eol()) {
+    t.number<double>("vertex value");
+    ++n;
+  }
+  const int base = x.normal + x.colour + x.st;
+  if (n == base || (x.colour && n == base + 1)) return;
+  std::string want;
+  auto add = [&](const char* s) { want += (want.empty() ? "" : ", ") + std::string(s); };
+  if (x.normal) add("a normal (3 values)");
+  if (x.colour) add("a colour (3 or 4 values)");
+  if (x.st) add("a texture coordinate (2 values)");
+  t.fail(std::string(magic) + " vertex needs x y z and " + want + " (" + std::to_string(n) +
+         " values after x y z)");
+}
+
 PolyMesh parse_off(std::string_view text, const std::string& name) {
   Tokens t{text.data(), text.data() + text.size(), name};
   const std::string_view magic = t.word();
@@ -340,7 +418,10 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
     if (t.e - q >= 6 && std::string_view(q, 6) == "BINARY") t.fail("binary OFF is not supported (ASCII OFF only)");
   }
   const long nv = t.number<long>("vertex count"), nf = t.number<long>("face count");
+  // The edge count may be missing ("3 1"): a face would otherwise be read as it.
+  if (t.at_eol()) t.fail("counts line needs vertices, faces and edges (found 2 numbers)");
   t.number<long>("edge count");
+  if (!t.at_eol()) t.fail("counts line holds more than vertices, faces and edges");
   if (nv < 0 || nf < 0 || nv > (1L << 31) || nf > (1L << 31)) t.fail("counts out of range");
   // Each vertex or face takes more than a byte: counts beyond the bytes that
   // follow are refused at once, and no more is reserved than those hold
@@ -352,19 +433,23 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
   t.next_line();
   PolyMesh m;
   m.positions.reserve(std::min(size_t(nv), size_t(left / 5) + 1));
+  const OffExtras extras = off_extras(magic);
   for (long i = 0; i < nv; ++i) {
-    t.skip(true);
+    // Fewer rows than the counts: said at the line where the file ends, not
+    // as "malformed face size ''" past it.
+    if (t.at_end()) t.fail("file ends after " + std::to_string(i) + " of the " + std::to_string(nv) + " vertices the counts declare");
     Vec3d p;
     p.x = t.number_on_line<double>("x coordinate");
     p.y = t.number_on_line<double>("y coordinate");
     p.z = t.number_on_line<double>("z coordinate");
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) t.fail("coordinate not finite");
+    check_off_extras(t, extras, magic);
     m.positions.push_back(p);
     t.next_line();
   }
   m.face_start.push_back(0);
   for (long f = 0; f < nf; ++f) {
-    t.skip(true);
+    if (t.at_end()) t.fail("file ends after " + std::to_string(f) + " of the " + std::to_string(nf) + " faces the counts declare");
     const long n = t.number<long>("face size");
     if (n < 3 || n > 1000000) t.fail("face with " + std::to_string(n) + " vertices");
     for (long j = 0; j < n; ++j) {
@@ -373,9 +458,14 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
         t.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices, from 0)");
       m.indices.push_back(v);
     }
+    // A colour may follow (a colour-map index, RGB or RGBA): numbers only.
+    int extra = 0;
+    while (!t.at_eol()) t.number<double>("face colour value"), ++extra;
+    if (extra == 2 || extra > 4) t.fail("face line has " + std::to_string(extra) + " values after its indices (a colour is 1, 3 or 4)");
     m.face_start.push_back(int(m.indices.size()));
-    t.next_line();  // colour values, if any
+    t.next_line();
   }
+  if (!t.at_end()) t.fail("data after the " + std::to_string(nf) + " faces the counts declare");
   check_faces(m, name);
   return m;
 }

@@ -1,6 +1,8 @@
 // PLY (ascii, binary little/big endian) and OFF readers, and the OBJ writer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cstring>
 
 #include "../errors.h"
@@ -97,6 +99,31 @@ TEST(Off, ReadsWithCommentsAndColours) {
   expect_square(parse_off("OFF\n# a comment\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3 255 0 0\n3 0 1 4\n",
                           "s.off"));
   expect_square(parse_off("OFF 5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3\n3 0 1 4\n", "s.off"));
+}
+
+// The values a magic promises are accepted in each form (a colour of 3 or
+// 4), and a CR-only file reads as lines (issue 15's fourth pass).
+TEST(Off, ExtrasTheMagicPromisesAndCrOnlyLineEnds) {
+  const std::string v = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n";
+  auto with = [&](const std::string& extra) {
+    std::string out;
+    for (std::size_t b = 0, e; (e = v.find('\n', b)) != std::string::npos; b = e + 1) out += v.substr(b, e - b) + extra + "\n";
+    return out;
+  };
+  const std::string faces = "4 0 1 2 3\n3 0 1 4\n";
+  expect_square(parse_off("NOFF\n5 2 0\n" + with(" 0 0 1") + faces, "n.off"));
+  expect_square(parse_off("COFF\n5 2 0\n" + with(" 1 0 0") + faces, "c.off"));
+  expect_square(parse_off("COFF\n5 2 0\n" + with(" 255 0 0 255") + faces, "c.off"));
+  expect_square(parse_off("STCNOFF\n5 2 0\n" + with(" 0 0 1 1 0 0 1 0.5 0.5") + faces, "s.off"));
+  std::string cr = "OFF\n5 2 0\n" + v + faces;
+  std::replace(cr.begin(), cr.end(), '\n', '\r');
+  expect_square(parse_off(cr, "cr.off"));
+  try {
+    parse_off("STOFF\n5 2 0\n" + with(" 0.5") + faces, "st.off");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "st.off:3: STOFF vertex needs x y z and a texture coordinate (2 values) (1 values after x y z)");
+  }
 }
 
 TEST(Off, Errors) {

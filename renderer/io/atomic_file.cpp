@@ -126,6 +126,11 @@ void OutputBatch::add(const std::filesystem::path& output) {
   declared_.push_back(output);
 }
 
+void OutputBatch::add_replacement(const std::filesystem::path& output) {
+  check_output_path(output);
+  outputs_.push_back(key(output));
+}
+
 bool OutputBatch::stage(const std::filesystem::path& path, const std::filesystem::path& tmp) {
   OutputBatch* b = g_batch;
   if (!b) return false;

@@ -50,6 +50,9 @@ class OutputBatch {
   OutputBatch& operator=(const OutputBatch&) = delete;
   // Adds an output known only later (e.g. a texture copied beside a .pov).
   void add(const std::filesystem::path& output);
+  // Adds an output that rewrites one of the command's inputs on purpose
+  // (golden bless: the golden it compared against): only the path is checked.
+  void add_replacement(const std::filesystem::path& output);
   void commit();
 
   // Used by write_atomically: true if `path` is this batch's (the rename waits).

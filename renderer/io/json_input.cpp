@@ -17,9 +17,12 @@ namespace {
 
 using json = nlohmann::json;
 
+// Lines end at \n, \r\n or a lone \r (a CR-only file put every error at
+// line 1: issue 15's fourth pass).
 long line_at(const std::string& text, std::size_t byte) {
   long line = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) line += text[i] == '\n';
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i)
+    line += text[i] == '\n' || (text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'));
   return line;
 }
 
@@ -49,32 +52,55 @@ struct CountingIter {
   bool operator!=(const CountingIter& o) const { return p != o.p; }
 };
 
+// A JSON pointer's reference token: '~' and '/' escaped (RFC 6901).
+std::string pointer_token(const std::string& k) {
+  std::string out;
+  for (char c : k) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+  return out;
+}
+
 class Sax {
  public:
-  Sax(json& root, const std::string& text, const std::string& file, const std::size_t& read)
-      : dom_(root, true), text_(text), file_(file), read_(read) {}
-  bool null() { return dom_.null(); }
-  bool boolean(bool v) { return dom_.boolean(v); }
-  bool number_integer(json::number_integer_t v) { return dom_.number_integer(v); }
-  bool number_unsigned(json::number_unsigned_t v) { return dom_.number_unsigned(v); }
-  bool number_float(json::number_float_t v, const std::string& s) { return dom_.number_float(v, s); }
-  bool string(std::string& v) { return dom_.string(v); }
-  bool binary(json::binary_t& v) { return dom_.binary(v); }
+  Sax(json& root, const std::string& text, const std::string& file, const std::size_t& read, JsonLines* lines)
+      : dom_(root, true), text_(text), file_(file), read_(read), lines_(lines) {}
+  bool null() { return value(), dom_.null(); }
+  bool boolean(bool v) { return value(), dom_.boolean(v); }
+  bool number_integer(json::number_integer_t v) { return value(), dom_.number_integer(v); }
+  bool number_unsigned(json::number_unsigned_t v) { return value(), dom_.number_unsigned(v); }
+  bool number_float(json::number_float_t v, const std::string& s) { return value(), dom_.number_float(v, s); }
+  bool string(std::string& v) { return value(), dom_.string(v); }
+  bool binary(json::binary_t& v) { return value(), dom_.binary(v); }
   bool start_object(std::size_t n) {
+    value();
     keys_.emplace_back();
+    if (lines_) path_.push_back(frame(false));
     return dom_.start_object(n);
   }
   bool key(std::string& k) {
     if (!keys_.back().insert(k).second)
       throw InputError(located(file_, line_at(text_, read_), "key \"" + k + "\" given twice in one object"));
+    if (lines_ && path_.back().tracked) {  // a member's line is its key's
+      path_.back().key = pointer_token(k);
+      (*lines_)[path_.back().prefix + "/" + path_.back().key] = line_at(text_, read_ ? read_ - 1 : 0);
+    }
     return dom_.key(k);
   }
   bool end_object() {
     keys_.pop_back();
+    if (lines_) path_.pop_back();
     return dom_.end_object();
   }
-  bool start_array(std::size_t n) { return dom_.start_array(n); }
-  bool end_array() { return dom_.end_array(); }
+  bool start_array(std::size_t n) {
+    value();
+    // Only when lines are asked for: the pointers of a document nested a
+    // million deep would take gigabytes (corpus scene/deep_nesting.json).
+    if (lines_) path_.push_back(frame(true));
+    return dom_.start_array(n);
+  }
+  bool end_array() {
+    if (lines_) path_.pop_back();
+    return dom_.end_array();
+  }
   bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& e) {
     const long line = line_at(text_, position == 0 ? 0 : position - 1);
     if (e.id == 406)  // number overflow: the lexer stands just after the number
@@ -89,34 +115,70 @@ class Sax {
  private:
   nlohmann::detail::json_sax_dom_parser<json> dom_;
   std::vector<std::set<std::string>> keys_;
+  // Where each value sits, for JsonLines: the containers open around it.
+  struct Frame {
+    bool array;
+    long index;       // arrays: the current element
+    std::string prefix;  // the container's own pointer
+    std::string key;  // objects: the current member's token
+    bool tracked = true;  // false below kMaxLineDepth: no lines recorded
+  };
+  // Lines are recorded 64 containers deep at most (deeper values take their
+  // ancestor's line): pointers of a document nested 100000 deep would
+  // otherwise take quadratic time and memory.
+  static constexpr std::size_t kMaxLineDepth = 64;
+  Frame frame(bool array) const {
+    if (path_.size() >= kMaxLineDepth) return {array, -1, "", "", false};
+    return {array, -1, path_.empty() ? "" : pointer_now(), "", true};
+  }
+  std::string pointer_now() const {
+    const Frame& f = path_.back();
+    return f.prefix + "/" + (f.array ? std::to_string(f.index) : f.key);
+  }
+  // A value starts: an array element's line is where it starts.
+  void value() {
+    if (!lines_ || path_.empty() || !path_.back().array || !path_.back().tracked) return;
+    ++path_.back().index;
+    (*lines_)[pointer_now()] = line_at(text_, read_ ? read_ - 1 : 0);
+  }
   const std::string& text_;
   const std::string& file_;
   const std::size_t& read_;
+  JsonLines* lines_;
+  std::vector<Frame> path_;
 };
 
 }  // namespace
 
-json parse_json_text(const std::string& text, const std::string& file) {
+json parse_json_text(const std::string& text, const std::string& file, JsonLines* lines) {
   // nlohmann reads UTF-8 only: UTF-16 would be "invalid literal; last read: '\xff'".
   if (text.rfind("\xFF\xFE", 0) == 0 || text.rfind("\xFE\xFF", 0) == 0 || text.find('\0') != std::string::npos)
     throw InputError(located(file, line_at(text, text.find('\0') == std::string::npos ? 0 : text.find('\0')),
                              "the file is UTF-16 (or holds NUL bytes): save it as UTF-8"));
   json root;
   std::size_t read = 0;
-  Sax sax(root, text, file, read);
+  Sax sax(root, text, file, read, lines);
   const char* b = text.data();
   CountingIter first{b, b, &read}, last{b + text.size(), b, &read};
   json::sax_parse(first, last, &sax);
   return root;
 }
 
-json read_json_file(const std::string& file) {
+long JsonLines::at(const std::string& pointer) const {
+  // The value itself, else the nearest enclosing one that was recorded.
+  for (std::string p = pointer;; p.resize(p.rfind('/'))) {
+    if (auto it = find(p); it != end()) return it->second;
+    if (p.empty() || p.rfind('/') == std::string::npos) return 0;
+  }
+}
+
+json read_json_file(const std::string& file, JsonLines* lines) {
   check_input_file(file);
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(located(file, 0, "cannot open"));
   std::ostringstream ss;
   ss << in.rdbuf();
-  return parse_json_text(ss.str(), file);
+  return parse_json_text(ss.str(), file, lines);
 }
 
 std::string json_error_text(const std::exception& e) {

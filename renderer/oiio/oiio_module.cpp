@@ -73,7 +73,7 @@ bool write_exr(const char* path, int w, int h, const float* rgb, std::string* er
 // library ("vector::_M_default_append" for a 65535x65535 GIF): said as such.
 std::string exception_text(const std::exception& e) {
   if (dynamic_cast<const std::length_error*>(&e) || dynamic_cast<const std::bad_alloc*>(&e))
-    return "the size the file declares cannot be allocated (corrupt header?)";
+    return "the size the file declares cannot be allocated (a corrupt header, or too little memory: `ulimit -v`?)";
   return e.what();
 }
 
@@ -84,16 +84,22 @@ void* open(const char* path, Header* header, std::string* err) try {
     return nullptr;
   }
   const OIIO::ImageSpec& spec = in->spec();
-  *header = Header{spec.width, spec.height, spec.nchannels};
+  const int type = spec.format == OIIO::TypeDesc::UINT8    ? ra::image_module::kUint8
+                   : spec.format == OIIO::TypeDesc::UINT16 ? ra::image_module::kUint16
+                                                           : ra::image_module::kFloat;
+  *header = Header{spec.width, spec.height, spec.nchannels, type};
   return in.release();
 } catch (const std::exception& e) {
   *err = exception_text(e);
   return nullptr;
 }
 
-bool read(void* image, int channels, float* dst, std::string* err) try {
+bool read(void* image, int channels, int type, void* dst, std::string* err) try {
   auto* in = static_cast<OIIO::ImageInput*>(image);
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, dst)) {
+  const OIIO::TypeDesc td = type == ra::image_module::kUint8    ? OIIO::TypeDesc::UINT8
+                            : type == ra::image_module::kUint16 ? OIIO::TypeDesc::UINT16
+                                                                : OIIO::TypeDesc::FLOAT;
+  if (!in->read_image(0, 0, 0, channels, td, dst)) {
     *err = first_line(in->geterror());
     return false;
   }

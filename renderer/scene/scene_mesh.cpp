@@ -34,9 +34,9 @@ Material material_from_mtl(const MtlMaterial& m, std::vector<std::string>* warni
   out.phong = (m.Ks.x + m.Ks.y + m.Ks.z) / 3;
   out.phong_size = m.Ns;
   if (!m.map_Kd.empty() && std::filesystem::exists(m.map_Kd))
-    out.texture = ImageTexture{m.map_Kd, TextureFilter::bilinear};
+    out.texture = ImageTexture{m.map_Kd, TextureFilter::bilinear, m.map_Kd_at};
   if (!m.map_bump.empty() && std::filesystem::exists(m.map_bump))
-    out.bump = BumpMap{m.map_bump, BumpVariant::height, m.bump_multiplier, TextureFilter::bilinear};
+    out.bump = BumpMap{m.map_bump, BumpVariant::height, m.bump_multiplier, TextureFilter::bilinear, m.map_bump_at};
   return out;
 }
 

@@ -24,13 +24,27 @@ int wrap_int(int i, int n) {
 
 }  // namespace
 
+Texture::Texture(StoredPixels&& p)
+    : width(p.width), height(p.height), channels(p.channels), rgb(std::move(p.f)), u8(std::move(p.u8)),
+      u16(std::move(p.u16)) {}
+
 Vec3d Texture::texel(int x, int y) const {
-  const float* p = &rgb[(std::size_t(wrap_int(y, height)) * width + wrap_int(x, width)) * 3];
-  return {p[0], p[1], p[2]};
+  const std::size_t i = (std::size_t(wrap_int(y, height)) * width + wrap_int(x, width)) * std::size_t(channels);
+  // OpenImageIO's uint8/uint16 -> float conversion (fmath.h convert_type).
+  auto at = [&](std::size_t k) -> float {
+    if (!u8.empty()) return float(u8[k]) * (1.0f / 255.0f);
+    if (!u16.empty()) return float(u16[k]) * (1.0f / 65535.0f);
+    return rgb[k];
+  };
+  if (channels == 1) {
+    const float g = at(i);
+    return {g, g, g};
+  }
+  return {at(i), at(i + 1), at(i + 2)};
 }
 
 void Texture::set(int x, int y, const Vec3d& c) {
-  float* p = &rgb[(std::size_t(y) * width + x) * 3];
+  float* p = &rgb[(std::size_t(y) * width + x) * 3];  // made in code: float RGB
   p[0] = float(c.x);
   p[1] = float(c.y);
   p[2] = float(c.z);
@@ -66,19 +80,8 @@ Vec3d Texture::bilinear(double u, double v) const {
 }
 
 Texture load_texture(const std::filesystem::path& file) {
-  int w = 0, h = 0, nc = 0;
-  const std::vector<float> all = read_pixels(file, "texture", w, h, nc);
-  std::optional<Texture> made;
-  try {
-    made.emplace(w, h);
-  } catch (const std::bad_alloc&) {
-    throw InputError(located(file.string(), 0, "texture of " + std::to_string(w) + "x" + std::to_string(h) +
-                                                   " pixels: not enough memory"));
-  }
-  Texture& t = *made;
-  for (std::size_t i = 0, n = std::size_t(w) * h; i < n; ++i)
-    for (int c = 0; c < 3; ++c) t.rgb[i * 3 + c] = all[i * nc + (nc >= 3 ? c : 0)];
-  return std::move(t);
+  // Read straight into the texture's own storage: no float copy on the way.
+  return Texture(read_stored_pixels(file, "texture"));
 }
 
 const Texture& TextureCache::load(const std::filesystem::path& file) {

@@ -7,12 +7,14 @@
 //    texels around (x + 0.5, y + 0.5), wrapping at the borders.
 // Values are raw: a PNG's 8-bit v is v / 255, no gamma decoding.
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "../image.h"
 #include "../scene/scene.h"
 #include "../vec.h"
 
@@ -21,12 +23,21 @@ namespace ra {
 // POV-Ray 3.7's EPSILON, added to image coordinates in map_pos.
 inline constexpr double kPovImageEpsilon = 1e-10;
 
+// Texels are kept as the file has them (image.h's StoredPixels: grey or
+// RGB, 8 or 16 bits or float), row-major, row 0 at the top; an 8-bit v
+// reads as float(v) * (1.0f / 255), exactly OpenImageIO's conversion, so
+// lookups are bit for bit those of a float copy, in a quarter (RGB) to a
+// twelfth (grey) of its memory. Textures made in code (set()) are float RGB.
 struct Texture {
   int width = 0, height = 0;
-  std::vector<float> rgb;  // row-major, row 0 at the top
+  int channels = 3;              // 1: grey, 3: RGB
+  std::vector<float> rgb;        // float texels (made in code, or a float file)
+  std::vector<std::uint8_t> u8;  // an 8-bit file's
+  std::vector<std::uint16_t> u16;
 
   Texture() = default;
   Texture(int w, int h) : width(w), height(h), rgb(std::size_t(w) * h * 3, 0.f) {}
+  explicit Texture(StoredPixels&& p);
 
   // The texel at integer (x, y), both wrapped into the image.
   Vec3d texel(int x, int y) const;
