@@ -254,35 +254,6 @@ TEST(BenchCli, FullDiskKeepsTheOldJson) {
 
 }  // namespace
 
-// HOSTILE2 F33-F36: --benchmark_list_tests with --json replaced OUT with
-// an empty file; bad pass-through values were Google Benchmark's own texts
-// (exit 1 or 0); --json could name a corpus mesh the rows read; on a full
-// disk the cut-short JSON replaced the previous file (checked in
-// ReliabilityCli's tmpfs tests' way only when root: here the refusals).
-// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
-// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
-// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
-TEST(BenchCli, DISABLED_ListTestsWithJsonBadPassThroughValuesAndCorpusOutputsAreRefused) {
-  const fs::path out = temp_json("keep.json");
-  std::ofstream(out) << "PRECIOUS\n";
-  const std::string row = " --filter 'kernel/moller/float/nocull/hit=50/back=0'";
-  const std::pair<std::string, std::string> cases[] = {
-      {"--benchmark_list_tests=true --json " + out.string(), "--benchmark_list_tests: runs no benchmark"},
-      {"--benchmark_repetitions=-5 --json " + out.string(), "--benchmark_repetitions: must be a whole number"},
-      {"--benchmark_format=xml --json " + out.string(), "--benchmark_format: must be console, json or csv"},
-      {"--json " + (ra::cache_dir() / "corpus" / "not-there.json").string(), "is in the corpus the benchmarks read"}};
-  for (const auto& [args, want] : cases) {
-    const auto r = run_rayaudit("bench" + row + " " + args);
-    EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
-    EXPECT_EQ(lines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(want), std::string::npos) << r.err;
-  }
-  std::ifstream in(out);
-  std::string kept;
-  std::getline(in, kept);
-  EXPECT_EQ(kept, "PRECIOUS");
-}
-
 // HOSTILE2 F35: on a full disk Google Benchmark's writer cut the JSON short
 // and it replaced the previous file, exit 0. Root only (a 64 KiB tmpfs).
 TEST(BenchCli, FullDiskKeepsThePreviousJson) {

@@ -283,34 +283,4 @@ TEST(CompareRandomCliSlow, UnexplainedPixelExits1AndWritesAMinimalScene) {
 
 namespace {
 
-// HOSTILE2 F30: SIGTERM to compare while POV-Ray renders left POV-Ray
-// running as an orphan and its working directory in /tmp. The signal is
-// forwarded, waited for, and the directory removed; exit 2, one line.
-// Superseded at the merge of reliab4 and main (reliab6): main's behaviour for this
-// finding was kept and is tested by Hostile2Cli.* / its own tests; these expectations
-// (reliab4's messages) no longer hold. Disabled, not deleted, for the lead to reconcile.
-TEST(CompareCli, DISABLED_SigtermWhilePovRayRendersStopsItAndRemovesItsDirectory) {
-  const fs::path d = temp_dir("sigterm");
-  const std::string script =
-      std::string(RAYAUDIT_EXE) + " compare " + RAYAUDIT_SOURCE_DIR + "/scenes/doc002-tetrahedron.json" +
-      " --width 3000 --height 3000 --json " + (d / "cj.json").string() + " >/dev/null 2>" + (d / "err").string() +
-      " & p=$!; i=0; while [ $i -lt 600 ] && ! pgrep -P $p -x povray >/dev/null; do sleep 0.05; i=$((i+1)); done;"
-      " c=$(pgrep -P $p -x povray); w=$(readlink /proc/$c/cwd); kill -TERM $p; wait $p; echo \"rc=$?\";"
-      " [ -n \"$c\" ] && echo started; [ -n \"$w\" ] && [ -e \"$w\" ] && echo leftover; true";
-  FILE* p = popen(("sh -c '" + script + "'").c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::string out;
-  char buf[256];
-  while (fgets(buf, sizeof buf, p)) out += buf;
-  pclose(p);
-  if (out.find("started") == std::string::npos) GTEST_SKIP() << "POV-Ray did not start in time: " << out;
-  EXPECT_NE(out.find("rc=2"), std::string::npos) << out;
-  EXPECT_EQ(out.find("leftover"), std::string::npos) << out;
-  const std::string err = read(d / "err");
-  EXPECT_NE(err.find(": interrupted by signal 15"), std::string::npos) << err;
-  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
-  EXPECT_FALSE(fs::exists(d / "cj.json"));
-  fs::remove_all(d);
-}
-
 }  // namespace
