@@ -418,9 +418,9 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
         else return tn_mem[k];
       };
       if (mask) {
-        // Ask for a child met and left on the stack: its node's lines, or
-        // its leaf's data; the loads overlap instead of following one
-        // another down the tree.
+        // Ask for every child met now: its node's lines, or its leaf's data
+        // (Embree does the same); the loads overlap instead of following
+        // one another down the tree.
         auto prefetch = [&](std::uint32_t c) __attribute__((always_inline)) {
           if (Bvh::is_leaf(c)) {
             leaf_prefetch(Bvh::leaf_first(c));
@@ -432,18 +432,19 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
             __builtin_prefetch(p + 192);
           }
         };
-        // Only the children left on the stack are asked for: the one taken
-        // next is read at once anyway, its loads issued together.
         if constexpr (!kClosest) {
-          // Any hit, in any order: every child met pushed in one pass, the
-          // last one taken back (one loop, fewer branches to mispredict
-          // than a separate one-child case).
-          const int base = top;
-          for (int m = mask; m; m &= m - 1) stack[top++] = n.child[__builtin_ctz(unsigned(m))];
+          // Any hit, in any order: every child met asked for and pushed in
+          // one pass, the last one taken back (one loop, fewer branches to
+          // mispredict than a separate one-child case).
+          for (int m = mask; m; m &= m - 1) {
+            const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
+            prefetch(c);
+            stack[top++] = c;
+          }
           cur = stack[--top];
-          for (int k = base; k < top; ++k) prefetch(stack[k]);
           continue;
         } else {
+          for (int m = mask; m; m &= m - 1) prefetch(n.child[__builtin_ctz(unsigned(m))]);
           const int i = __builtin_ctz(unsigned(mask));
           mask &= mask - 1;
           if (!mask) {  // one child: straight to it
@@ -455,7 +456,6 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
           if (!mask) {  // two children (the usual case): the nearer first
             const bool swap = tn(j) < tn(i);
             const int nearer = swap ? j : i, farther = swap ? i : j;
-            prefetch(n.child[farther]);
             stack[top++] = {n.child[farther], tn(farther)};
             cur = n.child[nearer];
             continue;
@@ -474,7 +474,6 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
             stack[k] = c;
           }
           cur = stack[--top].node;
-          for (int k = base; k < top; ++k) prefetch(stack[k].node);
           continue;
         }
       }
