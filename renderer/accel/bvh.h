@@ -51,11 +51,10 @@ namespace ra {
 // Eight children's boxes, structure of arrays: lo[axis][child]. 256 bytes
 // (224 used), four cache lines, aligned.
 struct alignas(64) BvhNode {
-  float lo[3][8];  // offset 0 (box_ray relies on lo at 0, hi at 96)
+  float lo[3][8];
   float hi[3][8];
   std::uint32_t child[8];  // Bvh::kEmpty, a leaf (Bvh::kLeaf | ...) or a node index
 };
-static_assert(offsetof(BvhNode, lo) == 0 && offsetof(BvhNode, hi) == 96, "box_ray's plane offsets");
 
 struct Bvh {
   static constexpr int kWidth = 8;  // children per node
@@ -135,10 +134,11 @@ inline float round_up(double x) {
 // broadcast from memory costs a load; eleven 8-lane copies per ray cost
 // more than the boxes a missing ray tests).
 typedef float v4f __attribute__((vector_size(16)));
-struct PlaneOffsets;
 struct BoxRay {
   v4f o, inv;  // lanes x, y, z (and 0, 1)
-  const PlaneOffsets* planes;  // where each axis's near and far planes are
+  // Byte offsets in BvhNode of each axis's near and far planes (hi is the
+  // near plane when d_a < 0, or -0).
+  unsigned near_off[3], far_off[3];
   float tmin;
   bool exact = true;  // false: float cannot hold this ray; visit every leaf
   // tmin >= 0 (every ray the tracer casts): then tnear >= 0, and tfar may
@@ -152,33 +152,6 @@ struct BoxRay {
   float abs_slack;
 };
 
-// Byte offsets in BvhNode of each axis's near and far planes, by the signs
-// of 1/d (bit a set: d_a < 0, or -0, and the near plane is hi): lo[a] is
-// at 32 a, hi[a] 96 bytes further.
-struct PlaneOffsets {
-  unsigned near_off[3], far_off[3];
-};
-inline constexpr PlaneOffsets kPlaneOffsets[8] = {
-    {{0, 32, 64}, {96, 128, 160}},   {{96, 32, 64}, {0, 128, 160}},   {{0, 128, 64}, {96, 32, 160}},
-    {{96, 128, 64}, {0, 32, 160}},   {{0, 32, 160}, {96, 128, 64}},   {{96, 32, 160}, {0, 128, 64}},
-    {{0, 128, 160}, {96, 32, 64}},   {{96, 128, 160}, {0, 32, 64}}};
-
-// x, y, z of v as floats (rounded to nearest, as float(v.x) is) and w: one
-// conversion of 4 lanes.
-template <class T>
-[[gnu::always_inline]] inline v4f lanes(const Vec3<T>& v, float w) {
-  if constexpr (sizeof(T) == 8) {
-    // SSE2 (so usable in this generic code): x, y in one load.
-    const __m128 xy = _mm_cvtpd_ps(_mm_loadu_pd(&v.x)), zw = _mm_cvtpd_ps(_mm_set_pd(double(w), v.z));
-    return (v4f)_mm_movelh_ps(xy, zw);
-  } else {
-    v4f x;
-    __builtin_memcpy(&x, &v, 3 * sizeof(float));
-    x[3] = w;
-    return x;
-  }
-}
-
 // One float division for the three 1/d_a, of d rounded to float (for double
 // rays one rounding more than the correctly rounded 1/d: 2 of the 16 ulps
 // of kRelSlack; a double division is slower, on every ray's critical path).
@@ -186,33 +159,30 @@ template <class T>
 [[gnu::always_inline]] inline BoxRay box_ray(const Vec3<T>& o, const Vec3<T>& d, T tmin) {
   typedef float v4 __attribute__((vector_size(16)));
   typedef int v4m __attribute__((vector_size(16)));
-  const v4 df = lanes(d, 1.f);
+  const v4 df{float(d.x), float(d.y), float(d.z), 1};
   const v4 inv = v4{1, 1, 1, 1} / df;
-  const v4 of = lanes(o, 0.f);
+  const v4 of{float(o.x), float(o.y), float(o.z), 0};
+  const v4m dz{-(d.x == 0), -(d.y == 0), -(d.z == 0), 0};
   const v4 abs_d = (v4)((v4m)df & 0x7FFFFFFF), abs_inv = (v4)((v4m)inv & 0x7FFFFFFF),
            abs_o = (v4)((v4m)of & 0x7FFFFFFF);
   const v4 oi = of * inv, abs_oi = (v4)((v4m)oi & 0x7FFFFFFF);
   // Float must hold the origin, and d_a and 1/d_a must be normal floats
-  // unless d_a = 0 (d_a's rounding to float must be relative). The usual
-  // ray has every axis normal; d == 0 is looked at only when one is not.
+  // unless d_a = 0 (d_a's rounding to float must be relative).
   constexpr float kMin = std::numeric_limits<float>::min();
   const v4m normal = (abs_d >= kMin) & (abs_inv >= kMin) & (abs_inv <= std::numeric_limits<float>::max());
+  const v4m ok = (abs_o <= 1e30f) & (dz | normal);
   const v4m fused = normal & (abs_oi <= std::numeric_limits<float>::max());
-  const int origin_ok = _mm_movemask_ps((__m128)(abs_o <= 1e30f));
-  const int normal_mask = _mm_movemask_ps((__m128)normal);
+  const int sign = _mm_movemask_ps((__m128)inv);
   BoxRay b;
   b.o = of;
   b.inv = inv;
   b.oi = oi;
-  if (normal_mask == 0xF) {
-    b.exact = origin_ok == 0xF;
-  } else {
-    const v4m dz{-(d.x == 0), -(d.y == 0), -(d.z == 0), 0};
-    b.exact = origin_ok == 0xF && _mm_movemask_ps((__m128)(dz | normal)) == 0xF;
+  b.exact = _mm_movemask_ps((__m128)ok) == 0xF;
+  for (int a = 0; a < 3; ++a) {
+    const bool near_hi = (sign >> a) & 1;
+    b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
+    b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
   }
-  // Near and far planes by the sign of 1/d_a (a row of a table: one load
-  // instead of six offsets worked out).
-  b.planes = &kPlaneOffsets[_mm_movemask_ps((__m128)inv) & 7];
   b.tmin = round_down(double(tmin));
   b.nonneg = b.tmin >= 0;
   b.fma_ok = b.exact && b.nonneg && (_mm_movemask_ps((__m128)fused) & 7) == 7;
@@ -227,7 +197,7 @@ template <class T>
 // (kept in registers or one load each through the loop).
 struct BoxRay8 {
   v8f o[3], inv[3], oi[3], tmin, abs_slack;
-  const PlaneOffsets* planes;
+  unsigned near_off[3], far_off[3];
   bool nonneg;
 };
 [[gnu::always_inline]] inline BoxRay8 widen(const BoxRay& r) {
@@ -242,7 +212,10 @@ struct BoxRay8 {
   w.oi[0] = __builtin_shufflevector(r.oi, r.oi, 0, 0, 0, 0, 0, 0, 0, 0);
   w.oi[1] = __builtin_shufflevector(r.oi, r.oi, 1, 1, 1, 1, 1, 1, 1, 1);
   w.oi[2] = __builtin_shufflevector(r.oi, r.oi, 2, 2, 2, 2, 2, 2, 2, 2);
-  w.planes = r.planes;
+  for (int a = 0; a < 3; ++a) {
+    w.near_off[a] = r.near_off[a];
+    w.far_off[a] = r.far_off[a];
+  }
   w.tmin = splat(r.tmin);
   w.abs_slack = splat(r.abs_slack);
   w.nonneg = r.nonneg;
@@ -255,8 +228,8 @@ struct BoxRay8 {
   v8f tn = r.tmin, tf = splat(tmax);
   for (int a = 0; a < 3; ++a) {
     const char* base = reinterpret_cast<const char*>(&n);
-    const v8f nearp = load8(reinterpret_cast<const float*>(base + r.planes->near_off[a]));
-    const v8f farp = load8(reinterpret_cast<const float*>(base + r.planes->far_off[a]));
+    const v8f nearp = load8(reinterpret_cast<const float*>(base + r.near_off[a]));
+    const v8f farp = load8(reinterpret_cast<const float*>(base + r.far_off[a]));
     const v8f t0 = (nearp - r.o[a]) * r.inv[a];
     const v8f t1 = (farp - r.o[a]) * r.inv[a];
     // NaN (origin exactly on the plane of a d_a = 0 slab) keeps the old bound.
@@ -343,8 +316,8 @@ struct BoxRay8 {
   const char* base = reinterpret_cast<const char*>(&n);
   v8f t0[3], t1[3];
   for (int a = 0; a < 3; ++a) {
-    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.planes->near_off[a])), r.inv[a], r.oi[a]);
-    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.planes->far_off[a])), r.inv[a], r.oi[a]);
+    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), r.inv[a], r.oi[a]);
+    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), r.inv[a], r.oi[a]);
   }
   // No NaN here: inv and oi are finite and nonzero-safe (empty children's
   // +-inf planes give +-inf).

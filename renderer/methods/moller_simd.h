@@ -7,8 +7,6 @@
 // and their left-to-right sums spelled out), and renderer/CMakeLists.txt
 // compiles with -ffp-contract=off so no multiply-add is ever fused.
 #pragma once
-#include <emmintrin.h>
-
 #include <cstdint>
 
 #include "../ray.h"
@@ -66,21 +64,13 @@ template <class T>
   return typename Lanes<T>::V{x, x, x, x};
 }
 
-// Bit i set when lane i of a comparison's mask is: SSE's movemask on each
-// 16-byte half (SSE2, so usable in this generic code; an AVX caller gets
-// two vmovmsk instructions instead of a lane-by-lane extraction).
+// Is any lane of a comparison's mask set?
 template <class T>
-[[gnu::always_inline]] inline int lane_mask(typename Lanes<T>::M m) {
-  if constexpr (sizeof(T) == 4) {
-    __m128 v;
-    __builtin_memcpy(&v, &m, 16);
-    return _mm_movemask_ps(v);
-  } else {
-    __m128d lo, hi;
-    __builtin_memcpy(&lo, &m, 16);
-    __builtin_memcpy(&hi, reinterpret_cast<const char*>(&m) + 16, 16);
-    return _mm_movemask_pd(lo) | _mm_movemask_pd(hi) << 2;
-  }
+[[gnu::always_inline]] inline bool any_lane(typename Lanes<T>::M m) {
+  std::int64_t w[sizeof m / 8];
+  __builtin_memcpy(w, &m, sizeof m);
+  if constexpr (sizeof m == 16) return (w[0] | w[1]) != 0;
+  else return ((w[0] | w[1]) | (w[2] | w[3])) != 0;
 }
 
 template <class T>
@@ -103,7 +93,7 @@ template <class T>
   // Most leaf tests miss every lane by here (shadow rays leaving the
   // surface, rays passing a leaf's box): skip the rest, whose only effect
   // is to reject more lanes.
-  if (!lane_mask<T>(ok)) {
+  if (!any_lane<T>(ok)) {
     out.hits = 0;
     return;
   }
@@ -113,7 +103,8 @@ template <class T>
   ok &= (v >= V{}) & (u + v <= V{} + T(1));
   const V t = (e2x * qx + e2y * qy + e2z * qz) * inv;
   ok &= (t >= bcast(r.tmin)) & (t <= bcast(r.tmax));
-  const int hits = lane_mask<T>(ok);
+  int hits = 0;
+  for (int i = 0; i < 4; ++i) hits |= ok[i] ? 1 << i : 0;
   out.hits = hits;
   if (!hits) return;
   __builtin_memcpy(out.t, &t, sizeof t);
