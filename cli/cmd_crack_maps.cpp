@@ -105,20 +105,20 @@ void run(const Args& a) {
   const std::filesystem::path parent = std::filesystem::absolute(dir).parent_path();
   if (!std::filesystem::is_directory(parent)) throw ra::InputError(a.out + ": its parent directory does not exist");
 
-  // The work is the product of the flags, each capped alone: at their caps
-  // about 34 hours, silent (HOSTILE2 F38). Refused beyond 2^28 pixels (a few
-  // hours at the ~70 us a pixel measured on the elephant), before any mesh
-  // is read.
+  // Absurd work is refused up front with its size, before any mesh is read
+  // (HOSTILE2 F38: the flags' own limits allowed ~34 hours, silently). A
+  // pixel of a map costs tens of microseconds (a closed mesh far from the
+  // origin, and the oracle).
   {
     const std::uint64_t n_meshes = 1 + (a.meshes.empty() ? 1 : a.meshes.size());
-    const std::uint64_t n_methods = ra::crack::map_methods(opt).size();
-    const std::uint64_t pixels = n_meshes * n_methods * opt.offsets.size() * std::uint64_t(a.size) * std::uint64_t(a.size);
-    constexpr std::uint64_t kMaxPixels = std::uint64_t(1) << 28;
-    if (pixels > kMaxPixels)
-      throw ra::InputError("crack-maps: " + std::to_string(n_meshes) + " meshes x " + std::to_string(n_methods) +
-                           " methods x " + std::to_string(opt.offsets.size()) + " offsets x " + std::to_string(a.size) +
-                           "^2 pixels = " + std::to_string(pixels) + " pixels, more than the limit of " +
-                           std::to_string(kMaxPixels) + " (hours of work): fewer --offsets or --methods, or a smaller --size");
+    const std::uint64_t maps = n_meshes * ra::crack::map_methods(opt).size() * opt.offsets.size();
+    const double pixel_maps = double(maps) * double(opt.size) * double(opt.size);
+    if (pixel_maps > kMaxPixelMaps)
+      throw ra::InputError("crack-maps: " + std::to_string(maps) + " maps of " + std::to_string(opt.size) + "x" +
+                           std::to_string(opt.size) + " pixels are " + std::to_string((long long)pixel_maps) +
+                           " pixels (about " + std::to_string((long long)(pixel_maps * 75e-6 / 60)) +
+                           " core-minutes); the limit is " + std::to_string((long long)kMaxPixelMaps) +
+                           ": fewer --offsets or --methods, or a smaller --size");
   }
   std::vector<ra::crack::ClosedMesh> meshes{ra::crack::audit_sphere()};
   if (a.meshes.empty()) {
@@ -150,16 +150,6 @@ void run(const Args& a) {
         throw ra::InputError(outputs[i].string() + ": two maps would have this name (meshes of one name, or "
                              "offsets or methods given twice): rename the mesh or drop the repeat");
   for (const auto& o : outputs) ra::check_output_name(o);
-  // Absurd work is refused up front with its size (HOSTILE2 F38: the flags'
-  // own limits allowed ~34 hours, silently). A pixel of a map costs tens of
-  // microseconds (a closed mesh far from the origin, and the oracle).
-  const double pixel_maps = double(outputs.size() - 1) * double(opt.size) * double(opt.size);
-  if (pixel_maps > kMaxPixelMaps)
-    throw ra::InputError("crack-maps: " + std::to_string(outputs.size() - 1) + " maps of " + std::to_string(opt.size) +
-                         "x" + std::to_string(opt.size) + " pixels are " + std::to_string((long long)pixel_maps) +
-                         " pixels (about " + std::to_string((long long)(pixel_maps * 75e-6 / 60)) +
-                         " core-minutes); the limit is " + std::to_string((long long)kMaxPixelMaps) +
-                         ": fewer --offsets or --methods, or a smaller --size");
   // The directory is made now and removed again if the run fails in it.
   std::error_code ec;
   const bool made_dir = !std::filesystem::exists(dir, ec);

@@ -665,19 +665,6 @@ TEST(ReliabilityCli, LongMaterialNamesAreQuotedShort) {
   EXPECT_NE(r.err.find("... (1000000 bytes)' is not defined"), std::string::npos) << r.err.substr(0, 300);
 }
 
-// HOSTILE2 F38: crack-maps' flags are capped one by one, their product was
-// about 34 hours of silent work; it is refused before any mesh is read.
-TEST(ReliabilityCli, CrackMapsWorkBeyondItsLimitIsRefusedUpFront) {
-  std::string offsets = "1";
-  for (int i = 2; i <= 100; ++i) offsets += "," + std::to_string(i);
-  const fs::path out = scratch("cm-huge");
-  const auto r = run_rayaudit("crack-maps -o " + out.string() + " --size 1024 --offsets " + offsets);
-  EXPECT_EQ(r.code, 2) << r.all;
-  EXPECT_TRUE(one_line(r.err)) << r.err;
-  EXPECT_NE(r.err.find("= 1677721600 pixels, more than the limit of 268435456"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(out));
-}
-
 // HOSTILE2 F23: `golden check /elsewhere/x.json` checked ROOT/scenes/x.json
 // and named that file; a path outside scenes/ is refused as such, and an
 // absolute path inside it is its scene.
