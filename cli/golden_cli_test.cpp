@@ -13,18 +13,11 @@
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;
+using ra::test::one_line;
 using ra::test::run_rayaudit;
+using ra::test::slurp;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == s.size() - 1; }
 
 // A repository with two scenes, a and b, blessed; then a's golden image
 // replaced by b's (same size, different pixels), so `check a` fails.

@@ -21,7 +21,9 @@
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;
+using ra::test::one_line;
 using ra::test::run_rayaudit;
+using ra::test::slurp;
 
 namespace {
 
@@ -32,15 +34,6 @@ fs::path scratch(const std::string& name) {
   fs::create_directories(d);
   return d / name;
 }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-bool one_line(const std::string& s) { return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1; }
 
 #if defined(__SANITIZE_ADDRESS__)
 constexpr bool kSanitized = true;

@@ -14,7 +14,9 @@
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;
+using ra::test::one_line;
 using ra::test::run_rayaudit;
+using ra::test::slurp;
 
 namespace {
 
@@ -26,13 +28,6 @@ fs::path scratch(const std::string& name) {
   return d / name;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // AddressSanitizer reserves terabytes of address space: tests that limit it
 // with prlimit --as cannot run under the asan preset.
 #if defined(__SANITIZE_ADDRESS__)
@@ -42,8 +37,6 @@ constexpr bool kSanitized = false;
 #endif
 #define SKIP_IF_SANITIZED() \
   if (kSanitized) GTEST_SKIP() << "prlimit --as and AddressSanitizer do not mix"
-
-bool one_line(const std::string& s) { return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1; }
 
 TEST(ReliabilityCli, RenderOnAFullDiskExits2AndKeepsTheGoodPng) {
   ra::test::FullDisk disk;

@@ -12,7 +12,9 @@
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;
+using ra::test::one_line;
 using ra::test::run_rayaudit;
+using ra::test::slurp;
 
 namespace {
 
@@ -21,8 +23,6 @@ fs::path scratch(const std::string& name) {
   fs::create_directories(d);
   return d / name;
 }
-
-bool one_line(const std::string& s) { return !s.empty() && s.find('\n') == s.size() - 1; }
 
 // Two facing mirrors of reflection 2 at max_depth 256: 2^256 overflows a
 // float. An EXR would have held +inf (exit 0): refused, naming the scene

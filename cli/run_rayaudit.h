@@ -42,4 +42,15 @@ inline CliResult run_rayaudit(const std::string& args, const std::string& env = 
   return r;
 }
 
+// A file's bytes (empty when it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Exactly one line, ending in a newline (the bad-input rule for stderr).
+inline bool one_line(const std::string& s) { return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1; }
+
 }  // namespace ra::test
