@@ -59,10 +59,29 @@ std::string pointer_token(const std::string& k) {
   return out;
 }
 
+// line_at for a reader that moves forward: each call goes on from the
+// last instead of from the start (the SAX records a line for every value;
+// from the start each time, a 2,000-entry golden manifest took 12.8 s).
+class LineCursor {
+ public:
+  explicit LineCursor(const std::string& text) : text_(text) {}
+  long at(std::size_t byte) {
+    if (byte < pos_) pos_ = 0, line_ = 1;
+    for (; pos_ < byte && pos_ < text_.size(); ++pos_)
+      line_ += text_[pos_] == '\n' || (text_[pos_] == '\r' && (pos_ + 1 == text_.size() || text_[pos_ + 1] != '\n'));
+    return line_;
+  }
+
+ private:
+  const std::string& text_;
+  std::size_t pos_ = 0;
+  long line_ = 1;
+};
+
 class Sax {
  public:
   Sax(json& root, const std::string& text, const std::string& file, const std::size_t& read, JsonLines* lines)
-      : dom_(root, true), text_(text), file_(file), read_(read), lines_(lines) {}
+      : dom_(root, true), text_(text), file_(file), read_(read), lines_(lines), cursor_(text) {}
   bool null() { return value(), dom_.null(); }
   bool boolean(bool v) { return value(), dom_.boolean(v); }
   bool number_integer(json::number_integer_t v) { return value(), dom_.number_integer(v); }
@@ -78,10 +97,10 @@ class Sax {
   }
   bool key(std::string& k) {
     if (!keys_.back().insert(k).second)
-      throw InputError(located(file_, line_at(text_, read_), "key \"" + k + "\" given twice in one object"));
+      throw InputError(located(file_, cursor_.at(read_), "key \"" + k + "\" given twice in one object"));
     if (lines_ && path_.back().tracked) {  // a member's line is its key's
       path_.back().key = pointer_token(k);
-      (*lines_)[path_.back().prefix + "/" + path_.back().key] = line_at(text_, read_ ? read_ - 1 : 0);
+      (*lines_)[path_.back().prefix + "/" + path_.back().key] = cursor_.at(read_ ? read_ - 1 : 0);
     }
     return dom_.key(k);
   }
@@ -102,7 +121,7 @@ class Sax {
     return dom_.end_array();
   }
   bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& e) {
-    const long line = line_at(text_, position == 0 ? 0 : position - 1);
+    const long line = cursor_.at(position == 0 ? 0 : position - 1);
     if (e.id == 406)  // number overflow: the lexer stands just after the number
       throw InputError(located(file_, line, "number " + token + " overflows a double"));
     std::string msg = e.what();
@@ -139,12 +158,13 @@ class Sax {
   void value() {
     if (!lines_ || path_.empty() || !path_.back().array || !path_.back().tracked) return;
     ++path_.back().index;
-    (*lines_)[pointer_now()] = line_at(text_, read_ ? read_ - 1 : 0);
+    (*lines_)[pointer_now()] = cursor_.at(read_ ? read_ - 1 : 0);
   }
   const std::string& text_;
   const std::string& file_;
   const std::size_t& read_;
   JsonLines* lines_;
+  LineCursor cursor_;
   std::vector<Frame> path_;
 };
 
