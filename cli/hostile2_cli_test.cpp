@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -228,12 +229,27 @@ std::set<fs::path> pov_work_dirs() {
   return out;
 }
 
-// Processes whose working directory is `dir` (POV-Ray runs in its own).
-int processes_in(const fs::path& dir) {
+// Processes whose working directory is `dir` (POV-Ray runs in its own);
+// with `parent` > 0 only its children (other tests run POV-Ray at the same
+// time under `ctest -j`, in directories of the same pattern).
+int processes_in(const fs::path& dir, pid_t parent = 0) {
   int n = 0;
   for (const auto& e : fs::directory_iterator("/proc")) {
     std::error_code ec;
-    if (fs::read_symlink(e.path() / "cwd", ec) == dir && !ec) ++n;
+    if (fs::read_symlink(e.path() / "cwd", ec) != dir || ec) continue;
+    if (parent > 0) {
+      // /proc/PID/stat: "pid (comm) state ppid ..."; comm may hold spaces.
+      std::ifstream in(e.path() / "stat");
+      std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      const std::size_t close = stat.rfind(')');
+      if (close == std::string::npos) continue;
+      std::istringstream rest(stat.substr(close + 1));
+      std::string state;
+      long ppid = 0;
+      rest >> state >> ppid;
+      if (ppid != long(parent)) continue;
+    }
+    ++n;
   }
   return n;
 }
@@ -264,7 +280,7 @@ TEST(Hostile2Cli, InterruptedCompareLeavesNoPovRayAndNoDirectory) {
     for (int i = 0; i < 600 && work.empty(); ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
       for (const auto& d : pov_work_dirs())
-        if (!before.count(d) && processes_in(d) > 0) work = d;
+        if (!before.count(d) && processes_in(d, pid) > 0) work = d;
     }
     ASSERT_FALSE(work.empty()) << "POV-Ray never started";
     kill(pid, sig);
