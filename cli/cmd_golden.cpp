@@ -76,6 +76,19 @@ void check_root(const Args& a) {
 
 void check(const Args& a) {
   check_root(a);
+  // Folders the diff images would need that are not there yet: removed
+  // again if still empty when the command ends (a check that exits 2 on a
+  // later scene left its new, empty diff folder behind). Declared before
+  // the batch, so that it runs after the batch has removed its temporaries.
+  struct RemoveMadeEmpty {
+    std::vector<std::filesystem::path> dirs;  // parents before children
+    ~RemoveMadeEmpty() {
+      for (auto it = dirs.rbegin(); it != dirs.rend(); ++it) {
+        std::error_code ec;
+        if (std::filesystem::is_empty(*it, ec) && !ec) std::filesystem::remove(*it, ec);
+      }
+    }
+  } made;
   ra::OutputBatch outputs({a.json});
   const ra::GoldenSet set(a.root);
   const std::filesystem::path diff_dir =
@@ -95,6 +108,19 @@ void check(const Args& a) {
     for (const std::filesystem::path& in : set.inputs_of(n))
       if (std::filesystem::is_regular_file(in)) ra::note_input(in);
   check_creatable_dir(diff_dir, "--diff-dir");
+  // (Folders the diff images need that are not there yet: `made`, above.)
+  for (const auto& n : names)
+    for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {
+      std::vector<std::filesystem::path> missing;
+      std::error_code ec;
+      for (auto d = std::filesystem::absolute(out).lexically_normal().parent_path();
+           !d.empty() && !std::filesystem::exists(d, ec); d = d.parent_path()) {
+        missing.push_back(d);
+        if (d == d.parent_path()) break;
+      }
+      for (auto it = missing.rbegin(); it != missing.rend(); ++it)
+        if (std::find(made.dirs.begin(), made.dirs.end(), *it) == made.dirs.end()) made.dirs.push_back(*it);
+    }
   std::set<std::filesystem::path> later;
   for (const auto& n : names)
     for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {

@@ -102,6 +102,17 @@ TEST_F(GoldenDataCli, CheckEndingInABadSceneWritesNothing) {
   EXPECT_TRUE(fs::is_empty(root / "out"));
 }
 
+// The same into a diff folder that is not there yet: the check makes it for
+// a's images, then exits 2 on b; the new folders are removed again.
+TEST_F(GoldenDataCli, CheckEndingInABadSceneLeavesNoNewDiffFolder) {
+  std::ofstream(root / "scenes" / "b.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})" << "\n";
+  const fs::path out = root / "made" / "diffs";
+  const auto r = run_rayaudit("golden check a b --root " + root.string() + " --diff-dir " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_FALSE(fs::exists(root / "made")) << "a new, empty diff folder was left behind";
+}
+
 // F4: `bless a BAD` rewrote a's golden, then failed on BAD: image and
 // manifest disagreed. Now every scene is rendered before anything is written.
 TEST_F(GoldenDataCli, BlessOfAGoodAndABadSceneWritesNothing) {
