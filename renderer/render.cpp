@@ -72,9 +72,6 @@ struct PreparedMesh {
   bool cull = false;  // --cull, and the mesh is closed (cull_unsafe_reason)
 };
 
-// Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
-// object, then the lower triangle, so the answer does not depend on the order
-// an acceleration structure visits them in.
 // Asks for a leaf block's cache lines ahead of its test.
 template <class B>
 [[gnu::always_inline]] inline void prefetch_block(const B& b) {
@@ -82,6 +79,9 @@ template <class B>
   for (std::size_t k = 0; k < sizeof(B); k += 64) __builtin_prefetch(p + k);
 }
 
+// Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
+// object, then the lower triangle, so the answer does not depend on the order
+// an acceleration structure visits them in.
 bool nearer(double t, int object, int prim, const SceneHit& best) {
   if (t != best.t) return t < best.t;
   if (object != best.object) return object < best.object;
@@ -134,6 +134,8 @@ struct Tracer::Impl {
       else meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
     }
     build_object_bvh();
+    one_mesh_tri4 = avx2 && s.objects.size() == 1 && s.objects[0].kind == Object::Kind::mesh && !opt.pov_mesh_intersect &&
+                    (opt.use_double ? !meshes_d[0].tri4.empty() : !meshes_f[0].tri4.empty());
     for (const Object& obj : s.objects) {
       if (obj.kind == Object::Kind::mesh)
         for (const Material& m : obj.mesh->materials) load_textures(m);
@@ -430,6 +432,61 @@ struct Tracer::Impl {
     if constexpr (sizeof(T) == 4) return meshes_f; else return meshes_d;
   }
 
+  // The closest hit in a mesh of Möller 4-wide leaves (tri4) through its
+  // BVH: consider(t, object, prim, b1, b2) for every hit in the window,
+  // which it narrows.
+  template <bool kFma, class T, class Consider>
+  [[gnu::always_inline]] static inline void closest_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& window,
+                                                            int oi, Consider&& consider) {
+    walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+      moller_simd::Hit4<T> h;
+      moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
+      for (int hits = h.hits; hits; hits &= hits - 1) {
+        const int l = __builtin_ctz(unsigned(hits));
+        consider(double(h.t[l]), oi, int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
+      }
+      return false;
+    }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+  }
+  template <bool kFma, class T>
+  [[gnu::always_inline]] static inline bool any_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& r) {
+    bool hit = false;
+    walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+      moller_simd::Hit4<T> h;
+      moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
+      return hit = h.hits != 0;
+    }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+    return hit;
+  }
+
+  // A scene that is one mesh under the BVH with Möller's 4-wide leaves (a
+  // bare .obj, the benchmark's rungs) has entry points of its own, without
+  // the loop over objects: their set-up (the object loop, the kind switch,
+  // the options read per ray, and the registers they take from the box
+  // test's set-up) cost about 200 of a primary ray's 560 instructions
+  // (callgrind, the bunny), where most rays leave after one node. The same
+  // kernels, window and tie rule, so the same hits.
+  bool one_mesh_tri4 = false;
+  template <class T>
+  [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_one_mesh_avx2(const Ray<double>& rd) const {
+    SceneHit best;
+    best.t = std::numeric_limits<double>::infinity();
+    Ray<T> window(rd);
+    closest_in_tri4<true>(meshes<T>()[0], false, window, 0,
+                          [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
+                            if (nearer(t, obj, prim, best)) {
+                              best = {t, obj, prim, b1, b2};
+                              window.tmax = T(t);
+                            }
+                          });
+    if (best.object < 0) return std::nullopt;
+    return best;
+  }
+  template <class T>
+  [[gnu::target("avx2,fma"), gnu::noinline]] bool occluded_one_mesh_avx2(const Ray<T>& r) const {
+    return any_in_tri4<true>(meshes<T>()[0], false, r);
+  }
+
   // Closest hit at precision T. The ray arrives in double (shading is done in
   // double); the kernels see it converted to T. Inlined into closest() and
   // closest_avx2(), which compile it for baseline x86-64 and for AVX2 and
@@ -474,15 +531,7 @@ struct Tracer::Impl {
           }
           if (opt.accel == Accel::bvh) {
             if (!m.tri4.empty()) {
-              walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
-                moller_simd::Hit4<T> h;
-                moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
-                for (int hits = h.hits; hits; hits &= hits - 1) {
-                  const int l = __builtin_ctz(unsigned(hits));
-                  consider(double(h.t[l]), int(oi), int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
-                }
-                return false;
-              }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+              closest_in_tri4<kFma>(m, boxed, window, int(oi), consider);
               break;
             }
             walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
@@ -630,11 +679,7 @@ struct Tracer::Impl {
           if (opt.accel == Accel::bvh) {
             bool hit = false;
             if (!m.tri4.empty()) {
-              walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
-                moller_simd::Hit4<T> h;
-                moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
-                return hit = h.hits != 0;
-              }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+              hit = any_in_tri4<kFma>(m, boxed, r);
             } else {
               walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                 for (std::uint32_t slot = first; slot < first + count; ++slot)
@@ -719,6 +764,7 @@ struct Tracer::Impl {
   }
   template <class T>
   std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1) const {
+    if (one_mesh_tri4 && only <= 0) return closest_one_mesh_avx2<T>(rd);
     return avx2 ? closest_avx2<T>(rd, only) : closest_base<T>(rd, only);
   }
   template <class T>
@@ -738,7 +784,10 @@ struct Tracer::Impl {
     return occluded_impl<T, true>(r);
   }
   template <class T>
-  bool occluded(const Ray<T>& r) const { return avx2 ? occluded_avx2<T>(r) : occluded_base<T>(r); }
+  bool occluded(const Ray<T>& r) const {
+    if (one_mesh_tri4) return occluded_one_mesh_avx2<T>(r);
+    return avx2 ? occluded_avx2<T>(r) : occluded_base<T>(r);
+  }
 
   std::optional<SceneHit> intersect(const Ray<double>& r) const {
     return opt.use_double ? closest<double>(r) : closest<float>(r);

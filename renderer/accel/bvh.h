@@ -36,6 +36,7 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -105,8 +106,14 @@ typedef int v8i __attribute__((vector_size(32)));
   __builtin_memcpy(&v, p, sizeof v);
   return v;
 }
-// A broadcast (v8f{} + x would add +0 to every lane: not foldable, -0 + 0 = +0).
-[[gnu::always_inline]] inline v8f splat(float x) { return v8f{x, x, x, x, x, x, x, x}; }
+// A broadcast (v8f{} + x would add +0 to every lane: not foldable, -0 + 0 = +0),
+// written as a shuffle of lane 0: one vbroadcastss (GCC builds v8f{x, ...}
+// from 4 vinsertps and a vperm2f128).
+typedef float v4f __attribute__((vector_size(16)));
+[[gnu::always_inline]] inline v8f splat(float x) {
+  const v4f v{x, x, x, x};
+  return __builtin_shufflevector(v, v, 0, 0, 0, 0, 0, 0, 0, 0);
+}
 [[gnu::always_inline]] inline v8f vabs(v8f x) { return (v8f)((v8i)x & 0x7FFFFFFF); }
 [[gnu::always_inline]] inline int movemask(v8i m) {
   __m128 lo, hi;
@@ -130,15 +137,28 @@ inline float round_up(double x) {
   return f > 1e-30f ? f * (1 + 0x1p-23f) : f < -1e-30f ? f * (1 - 0x1p-23f) : f + 1e-30f;
 }
 
+// Byte offsets in BvhNode of each axis's near and far planes, by the signs
+// of the three 1/d_a (bit a set: 1/d_a < 0 or -0, and hi is the near plane):
+// kPlanes[signs][0..2] near, [3..5] far. A row of a table instead of six
+// values made per ray (they are read from memory in the loop either way).
+constexpr unsigned plane_offset(int signs, int a, bool near) {
+  return unsigned(((((signs >> a) & 1) != 0) == near ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32 * a);
+}
+#define RA_PLANES(s)                                                                                  \
+  {                                                                                                   \
+    plane_offset(s, 0, true), plane_offset(s, 1, true), plane_offset(s, 2, true),                     \
+        plane_offset(s, 0, false), plane_offset(s, 1, false), plane_offset(s, 2, false)               \
+  }
+inline constexpr unsigned kPlanes[8][6] = {RA_PLANES(0), RA_PLANES(1), RA_PLANES(2), RA_PLANES(3),
+                                           RA_PLANES(4), RA_PLANES(5), RA_PLANES(6), RA_PLANES(7)};
+#undef RA_PLANES
+
 // The ray as the box test sees it: scalars, broadcast where used (a
 // broadcast from memory costs a load; eleven 8-lane copies per ray cost
 // more than the boxes a missing ray tests).
-typedef float v4f __attribute__((vector_size(16)));
 struct BoxRay {
   v4f o, inv;  // lanes x, y, z (and 0, 1)
-  // Byte offsets in BvhNode of each axis's near and far planes (hi is the
-  // near plane when d_a < 0, or -0).
-  unsigned near_off[3], far_off[3];
+  const unsigned* planes;  // kPlanes row: near_off[3], far_off[3]
   float tmin;
   bool exact = true;  // false: float cannot hold this ray; visit every leaf
   // tmin >= 0 (every ray the tracer casts): then tnear >= 0, and tfar may
@@ -162,30 +182,32 @@ template <class T>
   const v4 df{float(d.x), float(d.y), float(d.z), 1};
   const v4 inv = v4{1, 1, 1, 1} / df;
   const v4 of{float(o.x), float(o.y), float(o.z), 0};
-  const v4m dz{-(d.x == 0), -(d.y == 0), -(d.z == 0), 0};
+  // Bit a set: d_a is exactly zero (either sign), tested on T's bits (a
+  // compare would cost a NaN-safe sequence of 6 instructions per axis).
+  auto zero = [](T x) __attribute__((always_inline)) {
+    if constexpr (sizeof(T) == 8) return (std::bit_cast<std::uint64_t>(x) << 1) == 0;
+    else return (std::bit_cast<std::uint32_t>(x) << 1) == 0;
+  };
+  const int dz = int(zero(d.x)) | int(zero(d.y)) << 1 | int(zero(d.z)) << 2;
   const v4 abs_d = (v4)((v4m)df & 0x7FFFFFFF), abs_inv = (v4)((v4m)inv & 0x7FFFFFFF),
            abs_o = (v4)((v4m)of & 0x7FFFFFFF);
   const v4 oi = of * inv, abs_oi = (v4)((v4m)oi & 0x7FFFFFFF);
   // Float must hold the origin, and d_a and 1/d_a must be normal floats
   // unless d_a = 0 (d_a's rounding to float must be relative).
   constexpr float kMin = std::numeric_limits<float>::min();
-  const v4m normal = (abs_d >= kMin) & (abs_inv >= kMin) & (abs_inv <= std::numeric_limits<float>::max());
-  const v4m ok = (abs_o <= 1e30f) & (dz | normal);
-  const v4m fused = normal & (abs_oi <= std::numeric_limits<float>::max());
-  const int sign = _mm_movemask_ps((__m128)inv);
+  const v4m normal_m = (abs_d >= kMin) & (abs_inv >= kMin) & (abs_inv <= std::numeric_limits<float>::max());
+  const int normal = _mm_movemask_ps((__m128)normal_m);
+  const int held = _mm_movemask_ps((__m128)(abs_o <= 1e30f));
+  const int fused = normal & _mm_movemask_ps((__m128)(abs_oi <= std::numeric_limits<float>::max()));
   BoxRay b;
   b.o = of;
   b.inv = inv;
   b.oi = oi;
-  b.exact = _mm_movemask_ps((__m128)ok) == 0xF;
-  for (int a = 0; a < 3; ++a) {
-    const bool near_hi = (sign >> a) & 1;
-    b.near_off[a] = unsigned(near_hi ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32u * unsigned(a);
-    b.far_off[a] = unsigned(near_hi ? offsetof(BvhNode, lo) : offsetof(BvhNode, hi)) + 32u * unsigned(a);
-  }
+  b.exact = (held & (dz | normal) & 7) == 7;
+  b.planes = kPlanes[_mm_movemask_ps((__m128)inv) & 7];
   b.tmin = round_down(double(tmin));
   b.nonneg = b.tmin >= 0;
-  b.fma_ok = b.exact && b.nonneg && (_mm_movemask_ps((__m128)fused) & 7) == 7;
+  b.fma_ok = b.exact && b.nonneg && (fused & 7) == 7;
   // E = 2^-22 max_a |oi_a| + 2^-126 bounds each |o_a inv_a - oi_a| (at most
   // half an ulp of oi_a, 2^-24 |oi_a|, or 2^-150 where oi_a is subnormal).
   const float m = std::max(std::max(abs_oi[0], abs_oi[1]), abs_oi[2]);
@@ -197,7 +219,7 @@ template <class T>
 // (kept in registers or one load each through the loop).
 struct BoxRay8 {
   v8f o[3], inv[3], oi[3], tmin, abs_slack;
-  unsigned near_off[3], far_off[3];
+  const unsigned* planes;  // kPlanes row: near_off[3], far_off[3]
   bool nonneg;
 };
 [[gnu::always_inline]] inline BoxRay8 widen(const BoxRay& r) {
@@ -212,10 +234,7 @@ struct BoxRay8 {
   w.oi[0] = __builtin_shufflevector(r.oi, r.oi, 0, 0, 0, 0, 0, 0, 0, 0);
   w.oi[1] = __builtin_shufflevector(r.oi, r.oi, 1, 1, 1, 1, 1, 1, 1, 1);
   w.oi[2] = __builtin_shufflevector(r.oi, r.oi, 2, 2, 2, 2, 2, 2, 2, 2);
-  for (int a = 0; a < 3; ++a) {
-    w.near_off[a] = r.near_off[a];
-    w.far_off[a] = r.far_off[a];
-  }
+  w.planes = r.planes;
   w.tmin = splat(r.tmin);
   w.abs_slack = splat(r.abs_slack);
   w.nonneg = r.nonneg;
@@ -228,8 +247,8 @@ struct BoxRay8 {
   v8f tn = r.tmin, tf = splat(tmax);
   for (int a = 0; a < 3; ++a) {
     const char* base = reinterpret_cast<const char*>(&n);
-    const v8f nearp = load8(reinterpret_cast<const float*>(base + r.near_off[a]));
-    const v8f farp = load8(reinterpret_cast<const float*>(base + r.far_off[a]));
+    const v8f nearp = load8(reinterpret_cast<const float*>(base + r.planes[a]));
+    const v8f farp = load8(reinterpret_cast<const float*>(base + r.planes[3 + a]));
     const v8f t0 = (nearp - r.o[a]) * r.inv[a];
     const v8f t1 = (farp - r.o[a]) * r.inv[a];
     // NaN (origin exactly on the plane of a d_a = 0 slab) keeps the old bound.
@@ -316,8 +335,8 @@ struct BoxRay8 {
   const char* base = reinterpret_cast<const char*>(&n);
   v8f t0[3], t1[3];
   for (int a = 0; a < 3; ++a) {
-    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.near_off[a])), r.inv[a], r.oi[a]);
-    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.far_off[a])), r.inv[a], r.oi[a]);
+    t0[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.planes[a])), r.inv[a], r.oi[a]);
+    t1[a] = fmsub(load8(reinterpret_cast<const float*>(base + r.planes[3 + a])), r.inv[a], r.oi[a]);
   }
   // No NaN here: inv and oi are finite and nonzero-safe (empty children's
   // +-inf planes give +-inf).
