@@ -55,14 +55,34 @@ constexpr double kMinCosIncidence = 1e-10;
 // stored in the BVH's slot order (bvh.order maps a slot to its triangle),
 // except for moller, whose leaves are 4-lane blocks instead
 // (methods/moller_simd.h; `pre` stays empty).
+// An allocator whose resize() leaves elements default-initialised (for
+// trivial types: unwritten), where every element is written right after:
+// a zeroing pass over the 72 MB of the dragon's leaf blocks cost as much
+// as writing them.
+template <class T>
+struct DefaultInit : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = DefaultInit<U>;
+  };
+  using std::allocator<T>::allocator;
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
 template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
   std::size_t stride = 0;
   std::vector<unsigned char> pre;  // per triangle, or per BVH slot
   Bvh bvh;                         // --accel bvh only
-  std::vector<moller_simd::Tri4<T>> tri4;  // per BVH leaf, moller only
-  std::vector<Vec3d> gnormal;        // per triangle, (B-A)x(C-A) normalised
+  std::vector<moller_simd::Tri4<T>, DefaultInit<moller_simd::Tri4<T>>> tri4;  // per BVH leaf, moller only
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
   double bs_radius = 0;
@@ -77,6 +97,16 @@ template <class B>
 [[gnu::always_inline]] inline void prefetch_block(const B& b) {
   const char* p = reinterpret_cast<const char*>(&b);
   for (std::size_t k = 0; k < sizeof(B); k += 64) __builtin_prefetch(p + k);
+}
+
+// A triangle's geometric normal, (B-A)x(C-A) normalised (zero for a
+// degenerate one). Computed at each hit rather than stored per triangle:
+// 24 bytes a triangle and a pass over the mesh before the first ray, for
+// one cross product per shaded hit.
+Vec3d unit_normal(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d n = cross(b - a, c - a);  // length = twice the area
+  const double len = length(n);
+  return len > 0 ? n / len : Vec3d{0, 0, 0};
 }
 
 // Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
@@ -311,21 +341,14 @@ struct Tracer::Impl {
     m.stride = k.pre_bytes;
     const bool pre = !bvh_tri4();
     if (pre) m.pre.resize(m.stride * set.triangles.size());
-    m.gnormal.reserve(set.triangles.size());
-    advise_huge_pages(m.gnormal.data(), set.triangles.size() * sizeof(Vec3d));
-    m.gnormal.resize(set.triangles.size());
-    parallel_chunks(set.triangles.size(), [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const auto& tri = set.triangles[i];
-        const Vec3d& a = set.positions[tri.v[0]];
-        const Vec3d& b = set.positions[tri.v[1]];
-        const Vec3d& c = set.positions[tri.v[2]];
-        if (pre) k.prepare(Vec3<T>(a), Vec3<T>(b), Vec3<T>(c), m.pre.data() + i * m.stride);
-        const Vec3d n = cross(b - a, c - a);  // length = twice the area
-        const double len = length(n);
-        m.gnormal[i] = len > 0 ? n / len : Vec3d{0, 0, 0};
-      }
-    });
+    if (pre)
+      parallel_chunks(set.triangles.size(), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const auto& tri = set.triangles[i];
+          k.prepare(Vec3<T>(set.positions[tri.v[0]]), Vec3<T>(set.positions[tri.v[1]]),
+                    Vec3<T>(set.positions[tri.v[2]]), m.pre.data() + i * m.stride);
+        }
+      });
     if (set.shading == Shading::smooth) m.vertex_normal = area_weighted_vertex_normals(set);
     Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
     for (const auto& p : set.positions) {
@@ -381,12 +404,15 @@ struct Tracer::Impl {
     if (bvh_tri4()) {
       m.tri4.reserve(slots / 4);
       advise_huge_pages(m.tri4.data(), slots / 4 * sizeof(m.tri4[0]));
-      m.tri4.resize(slots / 4);  // zeros: an unused lane is never hit
+      m.tri4.resize(slots / 4);  // not zeroed here: every lane is written once below
       parallel_chunks(slots / 4, [&](std::size_t begin, std::size_t end) {
         for (std::size_t l = begin; l < end; ++l) {
           for (int j = 0; j < 4; ++j) {
             const std::uint32_t t = m.bvh.order[4 * l + std::size_t(j)];
-            if (t == Bvh::kNoTriangle) continue;
+            if (t == Bvh::kNoTriangle) {  // zeros: det = 0, never a hit
+              m.tri4[l].set(j, Vec3<T>{0, 0, 0}, Vec3<T>{0, 0, 0}, Vec3<T>{0, 0, 0});
+              continue;
+            }
             const auto& tri = set.triangles[t];
             m.tri4[l].set(j, Vec3<T>(set.positions[tri.v[0]]), Vec3<T>(set.positions[tri.v[1]]),
                           Vec3<T>(set.positions[tri.v[2]]));
@@ -836,8 +862,7 @@ struct Tracer::Impl {
             b2 = ph.b2;
           }
         const double b0 = 1 - b1 - b2;
-        const auto& gn = opt.use_double ? meshes_d[mesh_index[h.object]].gnormal[h.prim]
-                                        : meshes_f[mesh_index[h.object]].gnormal[h.prim];
+        const Vec3d gn = unit_normal(a, b, c);
         s.ng = gn;
         s.n = gn;
         if (set.shading == Shading::smooth) {

@@ -80,13 +80,15 @@ struct Bvh {
 
   // Builds over triangles given by their boxes; `pad` widens every box.
   // Uses up to `threads` threads (0: all cores); the tree (nodes and order,
-  // byte for byte) does not depend on the thread count.
-  static Bvh build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, double pad, int threads = 0);
+  // byte for byte) depends neither on the thread count nor on `simd` (false:
+  // the baseline x86-64 build even where the CPU has AVX2).
+  static Bvh build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, double pad, int threads = 0,
+                   bool simd = true);
   // The same with triangles [begin, end)'s boxes written by `boxes` to
   // lo[0 .. end - begin) and hi[...] on the build's threads, a piece at a
   // time (no array of all the boxes).
   using BoxFn = std::function<void(std::size_t begin, std::size_t end, Vec3d* lo, Vec3d* hi)>;
-  static Bvh build(std::size_t n, const BoxFn& boxes, double pad, int threads = 0);
+  static Bvh build(std::size_t n, const BoxFn& boxes, double pad, int threads = 0, bool simd = true);
 };
 
 namespace bvh_detail {

@@ -292,6 +292,25 @@ TEST(BvhBuild, SameTreeForEveryThreadCountAndEveryTriangleOnce) {
   }
 }
 
+// The AVX2 build (bvh_build.inc compiled for AVX2) and the baseline one
+// make the same tree byte for byte, on one thread and on several, also far
+// from the origin (where the rounding to float of every box matters) and
+// when every centroid coincides (the halving path).
+TEST(BvhBuild, SameTreeWithAndWithoutAvx2) {
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) GTEST_SKIP() << "no AVX2+FMA";
+  for (int kind : {0, 3}) {
+    std::vector<Vec3d> lo, hi;
+    random_boxes(kind == 0 ? 150000 : 20000, kind, 11, lo, hi);
+    for (std::vector<Vec3d>* v : {&lo, &hi})
+      for (Vec3d& p : *v) p = p + Vec3d{123456.75, -0.1, 3e4};
+    for (int t : {1, 2}) {
+      const Bvh avx2 = Bvh::build(lo, hi, 1e-3, t, true), base = Bvh::build(lo, hi, 1e-3, t, false);
+      check_structure(base, lo, hi);
+      EXPECT_TRUE(same_tree(avx2, base)) << "boxes " << kind << ", " << t << " threads";
+    }
+  }
+}
+
 // Coinciding centroids give SAH nothing to split: the build halves instead.
 TEST(BvhBuild, CoincidingCentroidsAreHalved) {
   std::vector<Vec3d> lo, hi;
