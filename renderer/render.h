@@ -33,6 +33,9 @@ struct RenderOptions {
   // Use AVX2 where the CPU has it (false: the baseline x86-64 SSE2 paths;
   // both give the same bits, which the Accel tests check).
   bool simd = true;
+  // With simd: the one-mesh entry points compiled for AVX-512 where the CPU
+  // has it (false: the AVX2 ones; the tests compare both).
+  bool avx512 = true;
   // Shade a mesh hit where POV-Ray 3.7's mesh2 puts it (renderer/pov_mesh.h):
   // the point O + t D with t from the triangle's float32 plane, and normals
   // and UVs interpolated there through POV's float32 Perp vector. Which

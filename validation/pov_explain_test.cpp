@@ -64,7 +64,9 @@ void expect_pixel_differs_and_is_explained_by(const Scene& scene, int x, int y, 
   ASSERT_TRUE(found) << "POV-Ray and we no longer differ at (" << x << ", " << y << "): the case is gone";
   for (const auto& e : explain_differences(scene, ours, pov, c, opt)) {
     EXPECT_FALSE(e.cause.empty()) << "(" << e.x << ", " << e.y << ") unexplained";
-    if (e.x == x && e.y == y) EXPECT_EQ(e.cause.rfind(cause, 0), 0u) << e.cause;
+    if (e.x == x && e.y == y) {
+      EXPECT_EQ(e.cause.rfind(cause, 0), 0u) << e.cause;
+    }
   }
 }
 

@@ -17,7 +17,7 @@ namespace {
 std::vector<std::string> shipped_scenes() {
   std::vector<std::string> out;
   const fs::path root = fs::path(RAYAUDIT_SOURCE_DIR) / "scenes";
-  for (const fs::path dir : {root, root / "corpus"})
+  for (const fs::path& dir : {root, root / "corpus"})
     for (const auto& e : fs::directory_iterator(dir))
       // The 871k-triangle dragon (9 s here, its BVH built three times) is left to golden/corpus.
       if (e.path().extension() == ".json" && e.path().stem() != "ladder-1M-dragon") out.push_back((e.path().parent_path() == root ? "" : "corpus/") + e.path().stem().string());
