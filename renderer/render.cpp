@@ -408,9 +408,25 @@ struct Tracer::Impl {
       advise_huge_pages(m.tri4.data(), slots / 4 * sizeof(m.tri4[0]));
       m.tri4.resize(slots / 4);  // not zeroed here: every lane is written once below
       parallel_chunks(slots / 4, [&](std::size_t begin, std::size_t end) {
+        // The slots visit the triangles in the tree's order, at random in
+        // memory: each lane's triangle record and then its three vertices
+        // are asked for ahead (16 and 8 blocks), so that the misses
+        // overlap instead of following one another (the dragon's 253k
+        // blocks: 75-120 ms before, 20-80 ms after, as the first touch of
+        // the blocks' fresh pages varies).
+        const std::uint32_t* order = m.bvh.order.data();
+        const std::size_t last = slots / 4;
         for (std::size_t l = begin; l < end; ++l) {
+          if (l + 16 < last)
+            for (int j = 0; j < 4; ++j)
+              if (const std::uint32_t t = order[4 * (l + 16) + std::size_t(j)]; t != Bvh::kNoTriangle)
+                __builtin_prefetch(&set.triangles[t]);
+          if (l + 8 < last)
+            for (int j = 0; j < 4; ++j)
+              if (const std::uint32_t t = order[4 * (l + 8) + std::size_t(j)]; t != Bvh::kNoTriangle)
+                for (int k = 0; k < 3; ++k) __builtin_prefetch(&set.positions[set.triangles[t].v[k]]);
           for (int j = 0; j < 4; ++j) {
-            const std::uint32_t t = m.bvh.order[4 * l + std::size_t(j)];
+            const std::uint32_t t = order[4 * l + std::size_t(j)];
             if (t == Bvh::kNoTriangle) {  // zeros: det = 0, never a hit
               m.tri4[l].set(j, Vec3<T>{0, 0, 0}, Vec3<T>{0, 0, 0}, Vec3<T>{0, 0, 0});
               continue;
