@@ -37,12 +37,18 @@ namespace bvh_build_base {
 #include "bvh_build.inc"
 }  // namespace bvh_build_base
 
+// (clang, which builds only the fuzz targets, has no such pragma: there
+// both copies are baseline code.)
+#if !defined(__clang__)
 #pragma GCC push_options
 #pragma GCC target("avx2,fma,bmi,bmi2,lzcnt,popcnt")
+#endif
 namespace bvh_build_avx2 {
 #include "bvh_build.inc"
 }  // namespace bvh_build_avx2
+#if !defined(__clang__)
 #pragma GCC pop_options
+#endif
 
 Bvh Bvh::build(const std::vector<Vec3d>& lo, const std::vector<Vec3d>& hi, double pad, int threads, bool simd) {
   return build(
