@@ -49,12 +49,6 @@ namespace {
 // POV-Ray skips a light whose N.L is below this (trace.cpp).
 constexpr double kMinCosIncidence = 1e-10;
 
-// A mesh ready for tracing at precision T: each triangle's prepared bytes
-// for the chosen method, its unit geometric normal, and the bounding sphere
-// of document 002's optimisation. With --accel bvh the prepared bytes are
-// stored in the BVH's slot order (bvh.order maps a slot to its triangle),
-// except for moller, whose leaves are 4-lane blocks instead
-// (methods/moller_simd.h; `pre` stays empty).
 // An allocator whose resize() leaves elements default-initialised (for
 // trivial types: unwritten), where every element is written right after:
 // a zeroing pass over the 72 MB of the dragon's leaf blocks cost as much
@@ -76,6 +70,13 @@ struct DefaultInit : std::allocator<T> {
   }
 };
 
+// A mesh ready for tracing at precision T: each triangle's prepared bytes
+// for the chosen method and the bounding sphere of document 002's
+// optimisation (the unit geometric normal is computed at each hit:
+// unit_normal). With --accel bvh the prepared bytes are stored in the
+// BVH's slot order (bvh.order maps a slot to its triangle), except for
+// moller, whose leaves are 4-lane blocks instead (methods/moller_simd.h;
+// `pre` stays empty).
 template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
