@@ -483,9 +483,10 @@ struct Tracer::Impl {
   template <bool kFma, class T, class Consider>
   [[gnu::always_inline]] static inline void closest_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& window,
                                                             int oi, Consider&& consider) {
+    const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(window);
     walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
       moller_simd::Hit4<T> h;
-      moller_simd::hit4(window, m.tri4[first / 4], m.cull, h);
+      moller_simd::hit4<kFma>(lanes, window.tmax, m.tri4[first / 4], m.cull, h);
       for (int hits = h.hits; hits; hits &= hits - 1) {
         const int l = __builtin_ctz(unsigned(hits));
         consider(double(h.t[l]), oi, int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
@@ -496,9 +497,10 @@ struct Tracer::Impl {
   template <bool kFma, class T>
   [[gnu::always_inline]] static inline bool any_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& r) {
     bool hit = false;
+    const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(r);
     walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
       moller_simd::Hit4<T> h;
-      moller_simd::hit4(r, m.tri4[first / 4], m.cull, h);
+      moller_simd::hit4<kFma>(lanes, r.tmax, m.tri4[first / 4], m.cull, h);
       return hit = h.hits != 0;
     }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
     return hit;
@@ -627,9 +629,10 @@ struct Tracer::Impl {
       for (const int oi : unbounded) visit(std::size_t(oi), false);
       if (const auto& m = soup<T>(); !m.bvh.nodes.empty()) {
         if (!m.tri4.empty()) {
+          const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(window);
           traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
             moller_simd::Hit4<T> h;
-            moller_simd::hit4(window, m.tri4[first / 4], false, h);
+            moller_simd::hit4<kFma>(lanes, window.tmax, m.tri4[first / 4], false, h);
             for (int hits = h.hits; hits; hits &= hits - 1) {
               const int l = __builtin_ctz(unsigned(hits));
               consider(double(h.t[l]), soup_object[m.bvh.order[first + l]], 0, double(h.b1[l]), double(h.b2[l]));
@@ -770,9 +773,10 @@ struct Tracer::Impl {
       bool hit = false;
       if (const auto& m = soup<T>(); !m.bvh.nodes.empty()) {
         if (!m.tri4.empty()) {
+          const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(r);
           traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
             moller_simd::Hit4<T> h;
-            moller_simd::hit4(r, m.tri4[first / 4], false, h);
+            moller_simd::hit4<kFma>(lanes, r.tmax, m.tri4[first / 4], false, h);
             return hit = h.hits != 0;
           }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
         } else {

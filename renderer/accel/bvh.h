@@ -279,7 +279,10 @@ struct BoxRay8 {
 // AVX2/FMA instruction each. Written as assembly because the traversal is
 // generic code inlined into the tracer's AVX2+FMA entry points (GCC does
 // not inline target-specific intrinsics into it); only those entry points
-// instantiate them (traverse's kFma).
+// instantiate them (traverse's kFma). Operands "v": any of the 32 vector
+// registers where the caller is compiled for AVX-512 ("x", the first 16
+// only, made GCC copy the ray's values into them: 7 moves a node);
+// vmovmskps has no AVX-512 encoding and keeps "x".
 #if defined(__clang__)
 // clang accepts a 32-byte "x" operand only in functions compiled for AVX,
 // and this generic code is not. Lane by lane, the same values: fmaf rounds
@@ -300,11 +303,11 @@ struct BoxRay8 {
 }
 #else
 [[gnu::always_inline]] inline v8f fmsub(v8f a, v8f b, v8f c) {
-  asm("vfmsub213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
+  asm("vfmsub213ps %2, %1, %0" : "+v"(a) : "v"(b), "vm"(c));
   return a;
 }
 [[gnu::always_inline]] inline v8f fmadd(v8f a, v8f b, v8f c) {
-  asm("vfmadd213ps %2, %1, %0" : "+x"(a) : "x"(b), "xm"(c));
+  asm("vfmadd213ps %2, %1, %0" : "+v"(a) : "v"(b), "vm"(c));
   return a;
 }
 // Lane i of v, without a trip through memory (storing v and loading a
@@ -313,7 +316,7 @@ struct BoxRay8 {
 [[gnu::always_inline]] inline float lane_avx(v8f v, int i) {
   const v8i idx{i, i, i, i, i, i, i, i};
   v8f r;
-  asm("vpermps %1, %2, %0" : "=x"(r) : "x"(v), "x"(idx));
+  asm("vpermps %1, %2, %0" : "=v"(r) : "v"(v), "v"(idx));
   return r[0];
 }
 [[gnu::always_inline]] inline int movemask_avx(v8i m) {
