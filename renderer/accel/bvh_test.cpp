@@ -140,6 +140,29 @@ bool slab_meets(const Vec3d& o, const Vec3d& d, double tmin, double tmax, const 
   return lo <= hi;
 }
 
+// The traversal's tmax in float: never below the double, whatever its
+// magnitude (subnormal floats, float's overflow, exact floats, both signs).
+TEST(Bvh, AboveIsNeverBelowItsArgument) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> mant(1, 2);
+  std::uniform_int_distribution<int> ex(-160, 127);  // below -FLT_MAX: -inf + inf, a NaN (an empty window)
+  int checked = 0;
+  for (int i = 0; i < 200000; ++i) {
+    double x = std::ldexp(mant(rng), ex(rng));
+    if (i % 3 == 0) x = double(float(x));         // exactly a float
+    if (i % 5 == 0) x = std::nextafter(x, 0.0);  // just below one
+    if (i % 2) x = -x;
+    const float a = bvh_detail::above(x);
+    ASSERT_GE(double(a), x) << std::hexfloat << x;
+    ASSERT_LE(double(a), x + std::fabs(x) * 0x1p-21 + 2e-30) << std::hexfloat << x;  // and tight
+    ++checked;
+  }
+  EXPECT_EQ(bvh_detail::above(INFINITY), INFINITY);
+  EXPECT_GE(double(bvh_detail::above(3.5e38)), 3.5e38);  // beyond float: +inf
+  EXPECT_EQ(bvh_detail::above(0.0), 1e-30f);
+  EXPECT_EQ(checked, 200000);
+}
+
 TEST(Bvh, FusedBoxTestNeverRejectsABoxTheSegmentMeets) {
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) GTEST_SKIP() << "no AVX2+FMA";
   using bvh_detail::round_down;
@@ -171,7 +194,7 @@ TEST(Bvh, FusedBoxTestNeverRejectsABoxTheSegmentMeets) {
         n.hi[a][c] = round_up(double(p + h));
       }
     }
-    const float tmax_f = round_up(tmax);
+    const float tmax_f = bvh_detail::above(tmax);  // as traverse rounds it
     float tn[8];
     const int mask = fused_mask(n, r, tmax_f, tn);
     const float prune = std::fma(tmax_f, 1 + 4 * Bvh::kRelSlack, r.abs_slack);
