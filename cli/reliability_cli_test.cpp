@@ -234,7 +234,9 @@ TEST(ReliabilityCli, Texture16384OneBitLoadsInItsOwnBytesOrIsRefusedUpFront) {
   rusage after{};
   ::getrusage(RUSAGE_CHILDREN, &after);
   // Largest child so far: this run, unless an earlier child was larger.
-  if (after.ru_maxrss > before.ru_maxrss) EXPECT_LT(after.ru_maxrss, 700L * 1024) << "peak resident KB";
+  if (after.ru_maxrss > before.ru_maxrss) {
+    EXPECT_LT(after.ru_maxrss, 700L * 1024) << "peak resident KB";
+  }
   const auto r = run_rayaudit(args, "prlimit --as=700000000 --");
   if (r.code == 0) GTEST_SKIP() << "OpenImageIO's libraries map less here: 700 MB holds the texture";
   EXPECT_EQ(r.code, 2);

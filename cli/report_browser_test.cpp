@@ -104,8 +104,9 @@ TEST(ReportBrowser, RealSmallRunOpensInChromiumWithEverythingDrawn) {
   for (const auto& e : rep["speed_accuracy"]) {
     for (const char* k : {"subject", "ns_per_test", "wrong_pct", "leaks_per_million"}) EXPECT_TRUE(e.contains(k)) << k;
     // The benchmark's kernel rows are on the speed axis.
-    if (corpus && (e["subject"] == "moller/float" || e["subject"] == "watertight/double"))
+    if (corpus && (e["subject"] == "moller/float" || e["subject"] == "watertight/double")) {
       EXPECT_GT(e["ns_per_test"].get<double>(), 0) << e;
+    }
   }
   if (corpus) {
     EXPECT_FALSE(rep["optimisations"]["speedups"].empty());

@@ -27,11 +27,13 @@
 namespace ra::audit {
 
 struct CheckOptions {
-  std::vector<std::string> families;  // empty: the assertion's own default
+  // Every member has an initializer, so a designated initializer that sets
+  // only some ({.families = {...}}) draws no -Wmissing-field-initializers.
+  std::vector<std::string> families{};  // empty: the assertion's own default
   long long rays = 20000;
   std::uint64_t seed = 1;
   int threads = 0;
-  std::optional<Shard> shard;         // unset: every ray
+  std::optional<Shard> shard{};         // unset: every ray
 };
 
 // GoogleTest's sharding variables as a Shard (index 0-based there, k 1-based

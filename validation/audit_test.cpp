@@ -368,8 +368,9 @@ TEST(AuditShards, ShardsPartitionEveryFamilyAndSweepValue) {
     for (const Report& p : parts) {
       // Each shard judges about a third of every cell (whole chunks of 256 probes).
       const double share = double(p.cells[c].stats.tests) / double(all.cells[c].stats.tests);
-      if (all.cells[c].family != "secondary")  // secondary: only the hits spawn
+      if (all.cells[c].family != "secondary") {  // secondary: only the hits spawn
         EXPECT_NEAR(share, 1.0 / 3, 0.15) << cell_dump(all.cells[c]);
+      }
       sum.merge(p.cells[c].stats);
     }
     Cell merged = all.cells[c];

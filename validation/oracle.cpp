@@ -228,7 +228,7 @@ struct I256 {
   std::uint64_t w[4] = {0, 0, 0, 0};
   void add_product(std::int64_t a, std::int64_t b, std::int64_t c) {
     using U128 = unsigned __int128;
-    const bool neg = (a < 0) != (b < 0) != (c < 0);
+    const bool neg = ((a < 0) != (b < 0)) != (c < 0);
     auto mag = [](std::int64_t x) { return x < 0 ? std::uint64_t(0) - std::uint64_t(x) : std::uint64_t(x); };
     const U128 ab = U128(mag(a)) * mag(b);
     const U128 p0 = U128(std::uint64_t(ab)) * mag(c);

@@ -56,7 +56,9 @@ TEST(RandomScene, ScenesParseAndExport) {
   EXPECT_GT(spheres, 0);
   EXPECT_GT(planes, 0);
   EXPECT_GT(triangles, 0);
-  if (!random_scene_meshes().empty()) EXPECT_GT(meshes, 0);
+  if (!random_scene_meshes().empty()) {
+    EXPECT_GT(meshes, 0);
+  }
 }
 
 // A constructed case: the "unexplained pixel" persists exactly while the

@@ -81,7 +81,7 @@ class LineCursor {
 class Sax {
  public:
   Sax(json& root, const std::string& text, const std::string& file, const std::size_t& read, JsonLines* lines)
-      : dom_(root, true), text_(text), file_(file), read_(read), lines_(lines), cursor_(text) {}
+      : dom_(root, true), file_(file), read_(read), lines_(lines), cursor_(text) {}
   bool null() { return value(), dom_.null(); }
   bool boolean(bool v) { return value(), dom_.boolean(v); }
   bool number_integer(json::number_integer_t v) { return value(), dom_.number_integer(v); }
@@ -160,7 +160,6 @@ class Sax {
     ++path_.back().index;
     (*lines_)[pointer_now()] = cursor_.at(read_ ? read_ - 1 : 0);
   }
-  const std::string& text_;
   const std::string& file_;
   const std::size_t& read_;
   JsonLines* lines_;

@@ -7,6 +7,8 @@
 // and their left-to-right sums spelled out), and renderer/CMakeLists.txt
 // compiles with -ffp-contract=off so no multiply-add is ever fused.
 #pragma once
+#include <immintrin.h>
+
 #include <cstdint>
 
 #include "../ray.h"
@@ -92,6 +94,8 @@ template <bool kAvx, class M>
     return r;
   }
 #endif
+  // 4 floats: one movmskps, baseline SSE.
+  if constexpr (sizeof(M) == 16) return _mm_movemask_ps((__m128)m);
   int bits = 0;
   for (int i = 0; i < 4; ++i) bits |= m[i] ? 1 << i : 0;
   return bits;

@@ -35,7 +35,7 @@ enum class BumpVariant { height, normal_map, pov };
 struct ImageTexture {
   std::filesystem::path file;
   TextureFilter filter = TextureFilter::bilinear;
-  std::string named_at;  // "m.mtl:7: map_Kd 'tex.png'" when an MTL names it: prefixes errors reading it
+  std::string named_at{};  // "m.mtl:7: map_Kd 'tex.png'" when an MTL names it: prefixes errors reading it
 };
 
 struct BumpMap {
@@ -43,7 +43,7 @@ struct BumpMap {
   BumpVariant variant = BumpVariant::height;
   double strength = 1.0;  // document 002's scale on dx, dy; POV's bump_size
   TextureFilter filter = TextureFilter::bilinear;
-  std::string named_at;  // as ImageTexture's
+  std::string named_at{};  // as ImageTexture's
 };
 
 // POV-Ray's finish terms (../shared/POVRAY.md), POV's defaults:
