@@ -370,19 +370,85 @@ struct BoxRay8 {
 
 namespace bvh_detail {
 
-// traverse's loop for one box test: kFused, meet8_fma (the ray has
-// fma_ok); otherwise meet8, or every child where float cannot hold the ray.
-template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
-[[gnu::always_inline]] inline void traverse_loop(const Bvh& bvh, const BoxRay& r, const T& tmax, Leaf&& leaf,
-                                                 LeafPrefetch&& leaf_prefetch) {
-  // Closest hit keeps each pushed box's tnear to skip it later; any hit
-  // needs only the node.
+// The children of node n whose boxes the ray meets: kFused, meet8_fma (the
+// ray has fma_ok); otherwise meet8, or every child where float cannot hold
+// the ray (tnear then -inf).
+template <bool kFused>
+[[gnu::always_inline]] inline int children_met(const BvhNode& n, const BoxRay& r, const BoxRay8& r8, float tmax_f,
+                                               v8f tmax_v, v8f& tnv) {
+  if constexpr (kFused) {
+    return meet8_fma(n, r8, tmax_v, tnv);
+  } else if (r.exact) {
+    return meet8(n, r8, tmax_f, tnv);
+  } else {
+    int mask = 0;
+    for (int i = 0; i < 8; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
+    tnv = splat(-INFINITY);
+    return mask;
+  }
+}
+
+// Asks for a node's four lines (Embree does the same for every child met):
+// the loads overlap instead of following one another down the tree.
+[[gnu::always_inline]] inline void prefetch_node(const BvhNode& n) {
+  const char* p = reinterpret_cast<const char*>(&n);
+  __builtin_prefetch(p);
+  __builtin_prefetch(p + 64);
+  __builtin_prefetch(p + 128);
+  __builtin_prefetch(p + 192);
+}
+
+// traverse's loop for any hit (kClosest false), in node order without
+// sorting. The leaves a node meets are tested at once, in child order,
+// after every child met has been asked for; only nodes go on the stack
+// (the last pushed taken next). Against pushing leaves and nodes alike
+// and taking the last: 1-3% faster shadow rays on the bunny and the
+// dragon (the leaf no longer makes a round trip through the stack, nor
+// the loop a leaf-or-node branch per step). Other orders measured slower:
+// nodes before leaves by 2%, leaves in reverse child order by 1-3%.
+template <bool kFused, class T, class Leaf, class LeafPrefetch>
+[[gnu::always_inline]] inline void traverse_any_loop(const Bvh& bvh, const BoxRay& r, const T& tmax, Leaf&& leaf,
+                                                     LeafPrefetch&& leaf_prefetch) {
+  std::uint32_t stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
+  int top = 0;
+  const float tmax_f = above(double(tmax));
+  const v8f tmax_v = splat(tmax_f);
+  const BoxRay8 r8 = widen(r);
+  std::uint32_t cur = 0;  // the root is a node (a lone leaf gets one)
+  for (;;) {
+    const BvhNode& n = bvh.nodes[cur];
+    v8f tnv;
+    const int mask = children_met<kFused>(n, r, r8, tmax_f, tmax_v, tnv);
+    std::uint32_t leaves[Bvh::kWidth];
+    int nl = 0;
+    for (int m = mask; m; m &= m - 1) {
+      const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
+      if (Bvh::is_leaf(c)) {
+        leaf_prefetch(Bvh::leaf_first(c));
+        leaves[nl++] = c;
+      } else {
+        prefetch_node(bvh.nodes[c]);
+        stack[top++] = c;
+      }
+    }
+    for (int k = 0; k < nl; ++k)
+      if (leaf(Bvh::leaf_first(leaves[k]), Bvh::leaf_count(leaves[k]))) return;
+    if (top == 0) return;
+    cur = stack[--top];
+  }
+}
+
+// traverse's loop for the closest hit: the nearest child met first, the
+// others pushed with their tnear; `tmax` re-read after every leaf (the leaf
+// test narrows it) and boxes entered beyond it skipped.
+template <bool kFused, class T, class Leaf, class LeafPrefetch>
+[[gnu::always_inline]] inline void traverse_closest_loop(const Bvh& bvh, const BoxRay& r, const T& tmax, Leaf&& leaf,
+                                                         LeafPrefetch&& leaf_prefetch) {
   struct Entry {
     std::uint32_t node;
     float tnear;
   };
-  using Slot = std::conditional_t<kClosest, Entry, std::uint32_t>;
-  Slot stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
+  Entry stack[(Bvh::kWidth - 1) * Bvh::kMaxDepth + 4];
   int top = 0;
   float tmax_f = above(double(tmax));
   v8f tmax_v = splat(tmax_f);
@@ -399,106 +465,66 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
   for (;;) {
     if (Bvh::is_leaf(cur)) {
       if (leaf(Bvh::leaf_first(cur), Bvh::leaf_count(cur))) return;
-      if constexpr (kClosest) {
-        tmax_f = above(double(tmax));
-        tmax_v = splat(tmax_f);
-        prune = prune_of(tmax_f);
-      }
+      tmax_f = above(double(tmax));
+      tmax_v = splat(tmax_f);
+      prune = prune_of(tmax_f);
     } else {
       const BvhNode& n = bvh.nodes[cur];
       alignas(32) float tn_mem[8];
-      int mask;
       v8f tnv;
-      {
-        if constexpr (kFused) {
-          mask = meet8_fma(n, r8, tmax_v, tnv);
-        } else if (r.exact) {
-          mask = meet8(n, r8, tmax_f, tnv);
-        } else {
-          mask = 0;
-          for (int i = 0; i < 8; ++i) mask |= n.child[i] != Bvh::kEmpty ? 1 << i : 0;
-          tnv = splat(-INFINITY);
-        }
-        if constexpr (kClosest && !kFused) __builtin_memcpy(tn_mem, &tnv, sizeof tn_mem);
-      }
-      // Child k's tnear (closest hit only).
+      int mask = children_met<kFused>(n, r, r8, tmax_f, tmax_v, tnv);
+      if constexpr (!kFused) __builtin_memcpy(tn_mem, &tnv, sizeof tn_mem);
+      // Child k's tnear.
       auto tn = [&](int k) __attribute__((always_inline)) {
         if constexpr (kFused) return lane_avx(tnv, k);
         else return tn_mem[k];
       };
       if (mask) {
-        // Ask for every child met now: its node's lines, or its leaf's data
-        // (Embree does the same); the loads overlap instead of following
-        // one another down the tree.
-        auto prefetch = [&](std::uint32_t c) __attribute__((always_inline)) {
-          if (Bvh::is_leaf(c)) {
-            leaf_prefetch(Bvh::leaf_first(c));
-          } else {
-            const char* p = reinterpret_cast<const char*>(&bvh.nodes[c]);
-            __builtin_prefetch(p);
-            __builtin_prefetch(p + 64);
-            __builtin_prefetch(p + 128);
-            __builtin_prefetch(p + 192);
-          }
-        };
-        if constexpr (!kClosest) {
-          // Any hit, in any order: every child met asked for and pushed in
-          // one pass, the last one taken back (one loop, fewer branches to
-          // mispredict than a separate one-child case).
-          for (int m = mask; m; m &= m - 1) {
-            const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
-            prefetch(c);
-            stack[top++] = c;
-          }
-          cur = stack[--top];
-          continue;
-        } else {
-          for (int m = mask; m; m &= m - 1) prefetch(n.child[__builtin_ctz(unsigned(m))]);
-          const int i = __builtin_ctz(unsigned(mask));
-          mask &= mask - 1;
-          if (!mask) {  // one child: straight to it
-            cur = n.child[i];
-            continue;
-          }
-          const int j = __builtin_ctz(unsigned(mask));
-          mask &= mask - 1;
-          if (!mask) {  // two children (the usual case): the nearer first
-            const bool swap = tn(j) < tn(i);
-            const int nearer = swap ? j : i, farther = swap ? i : j;
-            stack[top++] = {n.child[farther], tn(farther)};
-            cur = n.child[nearer];
-            continue;
-          }
-          // More: push all sorted so the nearest is on top, then take it.
-          const int base = top;
-          stack[top++] = {n.child[i], tn(i)};
-          for (mask |= 1 << j; mask; mask &= mask - 1) {
-            const int k0 = __builtin_ctz(unsigned(mask));
-            const Entry c{n.child[k0], tn(k0)};
-            int k = top++;
-            while (k > base && stack[k - 1].tnear < c.tnear) {
-              stack[k] = stack[k - 1];
-              --k;
-            }
-            stack[k] = c;
-          }
-          cur = stack[--top].node;
+        // Ask for every child met now: its node's lines, or its leaf's data.
+        for (int m = mask; m; m &= m - 1) {
+          const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
+          if (Bvh::is_leaf(c)) leaf_prefetch(Bvh::leaf_first(c));
+          else prefetch_node(bvh.nodes[c]);
+        }
+        const int i = __builtin_ctz(unsigned(mask));
+        mask &= mask - 1;
+        if (!mask) {  // one child: straight to it
+          cur = n.child[i];
           continue;
         }
+        const int j = __builtin_ctz(unsigned(mask));
+        mask &= mask - 1;
+        if (!mask) {  // two children (the usual case): the nearer first
+          const bool swap = tn(j) < tn(i);
+          const int nearer = swap ? j : i, farther = swap ? i : j;
+          stack[top++] = {n.child[farther], tn(farther)};
+          cur = n.child[nearer];
+          continue;
+        }
+        // More: push all sorted so the nearest is on top, then take it.
+        const int base = top;
+        stack[top++] = {n.child[i], tn(i)};
+        for (mask |= 1 << j; mask; mask &= mask - 1) {
+          const int k0 = __builtin_ctz(unsigned(mask));
+          const Entry c{n.child[k0], tn(k0)};
+          int k = top++;
+          while (k > base && stack[k - 1].tnear < c.tnear) {
+            stack[k] = stack[k - 1];
+            --k;
+          }
+          stack[k] = c;
+        }
+        cur = stack[--top].node;
+        continue;
       }
     }
     // Next from the stack, skipping boxes entered beyond the closest hit.
-    if constexpr (kClosest) {
-      for (;;) {
-        if (top == 0) return;
-        const Entry e = stack[--top];
-        if (e.tnear > prune) continue;
-        cur = e.node;
-        break;
-      }
-    } else {
+    for (;;) {
       if (top == 0) return;
-      cur = stack[--top];
+      const Entry e = stack[--top];
+      if (e.tnear > prune) continue;
+      cur = e.node;
+      break;
     }
   }
 }
@@ -509,8 +535,8 @@ template <bool kClosest, bool kFused, class T, class Leaf, class LeafPrefetch>
 // count)` returns true to stop, `leaf_prefetch(first_slot)` may ask for a
 // leaf's data when its box is met. kClosest: nearest box first, `tmax`
 // re-read after every leaf (closest-hit shrinks it) and boxes entered
-// beyond it skipped; otherwise (any hit) in node order, without sorting.
-// The nearest child hit is visited next without going through the stack.
+// beyond it skipped (traverse_closest_loop); otherwise (any hit) in node
+// order, without sorting (traverse_any_loop).
 // Always inlined, so that it is compiled for the ISA of its caller; kFma
 // only from callers compiled for AVX2 and FMA (meet8_fma's instructions).
 template <bool kClosest, bool kFma = false, class T, class Leaf, class LeafPrefetch>
@@ -519,10 +545,17 @@ template <bool kClosest, bool kFma = false, class T, class Leaf, class LeafPrefe
   using namespace bvh_detail;
   if (bvh.nodes.empty()) return;
   const BoxRay r = box_ray(o, d, tmin);
-  if constexpr (kFma) {
-    if (r.fma_ok) return traverse_loop<kClosest, true>(bvh, r, tmax, leaf, leaf_prefetch);
+  if constexpr (!kClosest) {
+    if constexpr (kFma) {
+      if (r.fma_ok) return traverse_any_loop<true>(bvh, r, tmax, leaf, leaf_prefetch);
+    }
+    traverse_any_loop<false>(bvh, r, tmax, leaf, leaf_prefetch);
+  } else {
+    if constexpr (kFma) {
+      if (r.fma_ok) return traverse_closest_loop<true>(bvh, r, tmax, leaf, leaf_prefetch);
+    }
+    traverse_closest_loop<false>(bvh, r, tmax, leaf, leaf_prefetch);
   }
-  traverse_loop<kClosest, false>(bvh, r, tmax, leaf, leaf_prefetch);
 }
 
 template <bool kClosest, bool kFma = false, class T, class Leaf>
