@@ -63,10 +63,11 @@ TEST(BenchCli, QuickSubsetHasEveryGroupNamesAndCounters) {
   const std::regex oracle("^oracle/[a-z-]+/threads=[0-9]+$");
   const std::regex obj("^obj/[A-Za-z0-9_-]+/(serial|parallel)$");
   std::map<std::string, int> groups;
-  for (const auto& [name, b] : rows) {
+  for (const auto& row : rows) {
+    const std::string& name = row.first;  // not a structured binding: clang 14 cannot capture those
     const std::string group = name.substr(0, name.find('/'));
     ++groups[group];
-    const auto& c = b;
+    const auto& c = row.second;
     auto has = [&](const char* counter) { EXPECT_TRUE(c.contains(counter)) << name << " lacks " << counter; };
     if (group == "kernel") {
       EXPECT_TRUE(std::regex_match(name, kernel)) << name;

@@ -122,7 +122,14 @@ TEST(Bvh, SameHitsAsEveryTriangleFarFromTheOrigin) {
 // mask, and its tnear must not exceed the pruning bound for tmax. Boxes
 // hug points of the ray, or graze it from one side, near and far from the
 // origin.
+// Compiled for AVX2 and FMA under GCC, where meet8_fma is their
+// instructions; clang's meet8_fma is lane-by-lane generic code (bvh.h), and
+// clang rejects 8-float vectors crossing between AVX and non-AVX code.
+#if defined(__clang__)
+int fused_mask(const BvhNode& n, const bvh_detail::BoxRay& r, float tmax, float* tnear) {
+#else
 [[gnu::target("avx2,fma")]] int fused_mask(const BvhNode& n, const bvh_detail::BoxRay& r, float tmax, float* tnear) {
+#endif
   const bvh_detail::BoxRay8 w = bvh_detail::widen(r);
   bvh_detail::v8f tn;
   const int m = bvh_detail::meet8_fma(n, w, bvh_detail::splat(tmax), tn);
