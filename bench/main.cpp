@@ -31,16 +31,17 @@
 // our acceleration structures): every operator new counts its usable size.
 namespace {
 std::atomic<long> g_live{0}, g_peak{0};
-void* counted_alloc(std::size_t n) {
-  void* p = std::malloc(n ? n : 1);
+// Adds a fresh block's usable size to the live count and raises the peak.
+void* counted(void* p) {
   if (!p) throw std::bad_alloc();
-  const long now = g_live.fetch_add(long(malloc_usable_size(p)), std::memory_order_relaxed) +
-                   long(malloc_usable_size(p));
+  const long size = long(malloc_usable_size(p));
+  const long now = g_live.fetch_add(size, std::memory_order_relaxed) + size;
   long peak = g_peak.load(std::memory_order_relaxed);
   while (now > peak && !g_peak.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
   }
   return p;
 }
+void* counted_alloc(std::size_t n) { return counted(std::malloc(n ? n : 1)); }
 void counted_free(void* p) {
   if (!p) return;
   g_live.fetch_sub(long(malloc_usable_size(p)), std::memory_order_relaxed);
@@ -52,13 +53,7 @@ void counted_free(void* p) {
 void* counted_aligned_alloc(std::size_t n, std::align_val_t al) {
   void* p = nullptr;
   const std::size_t a = std::max(sizeof(void*), std::size_t(al));
-  if (posix_memalign(&p, a, n ? n : 1) != 0) throw std::bad_alloc();
-  const long now = g_live.fetch_add(long(malloc_usable_size(p)), std::memory_order_relaxed) +
-                   long(malloc_usable_size(p));
-  long peak = g_peak.load(std::memory_order_relaxed);
-  while (now > peak && !g_peak.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
-  }
-  return p;
+  return counted(posix_memalign(&p, a, n ? n : 1) == 0 ? p : nullptr);
 }
 }  // namespace
 
