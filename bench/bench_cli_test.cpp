@@ -186,6 +186,22 @@ TEST(BenchCli, MissingPovRayIsAnError) {
                  "RAYAUDIT_POVRAY=/nonexistent/povray");
 }
 
+// The table redirected to a file (a CI log) holds no colour escapes, even
+// where TERM names a colour terminal: our reporter is passed to Google
+// Benchmark, and a ConsoleReporter made by hand colours unless told not to.
+// --benchmark_color=true still asks for them.
+TEST(BenchCli, NoColourEscapesUnlessOnATerminalOrAsked) {
+  const std::string row = "--filter '^kernel/plane/double/nocull/hit=50/back=0$' --benchmark_repetitions=1 "
+                          "--benchmark_min_time=0.01";
+  auto r = run_rayaudit("bench " + row, "TERM=xterm-256color");
+  ASSERT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.out.find("kernel/plane/double"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r.out;
+  r = run_rayaudit("bench " + row + " --benchmark_color=true", "TERM=xterm-256color");
+  ASSERT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.out.find('\x1b'), std::string::npos) << r.out;
+}
+
 TEST(BenchCli, OtherArgumentsAreRefused) {
   expect_refused("--bogus", "unknown argument \"--bogus\"");
   expect_refused("--benchmark_out=x.json", "use --json OUT");

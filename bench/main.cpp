@@ -285,6 +285,7 @@ class MemoryJson : public benchmark::BenchmarkReporter {
 // The console table as usual; remembers whether a row failed.
 class Reporter : public benchmark::ConsoleReporter {
  public:
+  explicit Reporter(OutputOptions options) : ConsoleReporter(options) {}
   bool failed = false;
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs)
@@ -331,7 +332,17 @@ int run(int argc, char** argv) {
   gb_argv.push_back(nullptr);
   benchmark::Initialize(&gb_argc, gb_argv.data());
   if (benchmark::ReportUnrecognizedArguments(gb_argc, gb_argv.data())) return 2;
-  Reporter reporter;
+  // Colour only on a terminal, unless --benchmark_color says: a reporter
+  // passed in, as this one is, colours by default, which put escapes in
+  // every log file the table was redirected to.
+  const char* term = std::getenv("TERM");
+  bool colour = isatty(STDOUT_FILENO) && term && std::strcmp(term, "dumb") != 0;
+  for (const std::string& p : a.passthrough)
+    if (p.rfind("--benchmark_color", 0) == 0) {
+      const std::string v = p.find('=') == std::string::npos ? "" : p.substr(p.find('=') + 1);
+      if (v != "auto") colour = gb_true(v);
+    }
+  Reporter reporter(colour ? benchmark::ConsoleReporter::OO_ColorTabular : benchmark::ConsoleReporter::OO_Tabular);
   // Google Benchmark prints its context banner on the error stream; on
   // stdout, stderr holds only errors (one line for a full disk at the end).
   reporter.SetErrorStream(&std::cout);

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -376,6 +377,68 @@ TEST(AuditGrade, BadAnswersExitTwoWithFileLineAndWriteNothing) {
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
   EXPECT_EQ(rayaudit("audit --grade " + answers.string()).code, 2) << "--grade needs --cases";
+}
+
+// Hand-made cases, judged by hand: a is a hit at t = 1 inside the unit
+// triangle; h lies 2^-53 beyond its hypotenuse in double (a miss) but
+// exactly on it once rounded to float (a boundary case).
+TEST(AuditGrade, NonFiniteTIsWrongAndFloatCasesAreRounded) {
+  const fs::path cases = tmp("gn_cases.csv"), answers = tmp("gn_answers.csv"), json = tmp("gn.json"),
+                 csv = tmp("gn.csv");
+  write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
+               "a,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n"
+               "h,0x1.0000000000001p-1,0x1p-1,-1,0,0,1,0,0,0,1,0,0,0,1,0\n");
+  auto totals = [&](const std::string& extra) {
+    fs::remove(json);
+    const Result r = rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " +
+                              json.string() + " " + extra);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return nlohmann::json::parse(slurp(json))["cells"][0]["stats"];
+  };
+  for (const char* t : {"nan", "inf", "-inf"}) {
+    write(answers, std::string("id,hit,t\na,true,") + t + "\nh,false,\n");
+    const auto s = totals("");
+    EXPECT_EQ(s["wrong_t"], 1) << t;
+    EXPECT_EQ(s["wrong"], 1) << t;
+    EXPECT_EQ(s["nan_inf"], 1) << t;
+    EXPECT_EQ(s["true_hits"], 1) << t;
+  }
+  write(answers, "id,hit,t\na,true,1\nh,true,1\n");
+  auto s = totals("--precision double");
+  EXPECT_EQ(s["false_hits"], 1);
+  EXPECT_EQ(s["wrong"], 1);
+  s = totals("--precision float");
+  EXPECT_EQ(s["false_hits"], 0);
+  EXPECT_EQ(s["boundary_hits"], 1);
+  EXPECT_EQ(s["wrong"], 0);
+  // One file of answers is one precision; the generator's options do not apply.
+  for (const char* opt : {"--precision float,double", "--rays 5", "--seed 9", "--families edge"}) {
+    fs::remove(json);
+    const Result r = rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " +
+                              json.string() + " " + opt);
+    EXPECT_EQ(r.code, 2) << opt;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+    EXPECT_FALSE(fs::exists(json)) << opt;
+  }
+  // A subject named after an answers file with a comma and a quote: the CSV
+  // quotes it, so every row has the header's number of fields.
+  const fs::path odd = tmp("my,ans\"wer.csv");
+  fs::copy_file(answers, odd, fs::copy_options::overwrite_existing);
+  const Result r = rayaudit("audit --grade '" + odd.string() + "' --cases " + cases.string() + " --csv " + csv.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream lines(slurp(csv));
+  std::string header, row;
+  std::getline(lines, header);
+  std::getline(lines, row);
+  EXPECT_EQ(row.rfind("\"my,ans\"\"wer\",double,", 0), 0u) << row;
+  // Fields outside quotes: the header's count.
+  int fields = 1;
+  bool quoted = false;
+  for (char ch : row) {
+    if (ch == '"') quoted = !quoted;
+    else if (ch == ',' && !quoted) ++fields;
+  }
+  EXPECT_EQ(fields, int(std::count(header.begin(), header.end(), ',')) + 1) << row;
 }
 
 // Answers as spreadsheets save them: a UTF-8 BOM is dropped (it read

@@ -173,31 +173,39 @@ void audit_cases(const Args& a) {
   std::vector<const ra::Method*> tri_methods;
   for (const ra::Method* m : chosen_methods(a.methods))
     if (m->kind == ra::Kind::triangle) tri_methods.push_back(m);
+  const auto ps = chosen_precisions(a.precision);
+  const char* columns = ps.size() == 2 ? "float dbl" : ps[0] == Precision::f32 ? "float" : "dbl";
   auto grade_all = [&](std::ostream* json) {
     std::printf("%-16s %-10s %-24s", "ID", "VERDICT", "T (exact)");
     for (const auto* m : tri_methods) std::printf(" %-11.11s", m->name.c_str());
     std::printf("\n%-16s %-10s %-24s", "", "", "");
-    for (std::size_t i = 0; i < tri_methods.size(); ++i) std::printf(" %-11s", "float dbl");
+    for (std::size_t i = 0; i < tri_methods.size(); ++i) std::printf(" %-11s", columns);
     std::printf("\n");
     long wrong = 0, n = 0;
     for_each_case(a.cases, [&](const UserCase& c, long) {
       const auto ans = ra::oracle::triangle(c.ray, c.tri.a, c.tri.b, c.tri.c);
+      // Float answers are judged on the case rounded to float, what a float
+      // method is given (the verdict can differ: a point 1 ulp off an edge
+      // in double lies on it in float).
+      const ra::Vec3f fa(c.tri.a), fb(c.tri.b), fc(c.tri.c);
+      const ra::Rayf fray(c.ray);
+      const auto ans_f = ra::oracle::triangle(ra::Rayd(fray), ra::Vec3d(fa), ra::Vec3d(fb), ra::Vec3d(fc));
       nlohmann::json answers = nlohmann::json::object();
       std::printf("%-16.16s %-10s %-24.17g", c.id.c_str(), std::string(ra::oracle::verdict_name(ans.verdict)).c_str(), ans.t);
       for (const auto* m : tri_methods) {
         std::string cell;
         for (Precision p : {Precision::f32, Precision::f64}) {
+          if (std::find(ps.begin(), ps.end(), p) == ps.end()) continue;
           std::optional<double> t;
           if (p == Precision::f32) {
-            if (auto h = m->tri_f.hit(ra::Rayf(c.ray), ra::Vec3f(c.tri.a), ra::Vec3f(c.tri.b), ra::Vec3f(c.tri.c), false))
-              t = double(h->t);
+            if (auto h = m->tri_f.hit(fray, fa, fb, fc, false)) t = double(h->t);
           } else if (auto h = m->tri_d.hit(c.ray, c.tri.a, c.tri.b, c.tri.c, false)) {
             t = h->t;
           }
           answers[m->name + "/" + precision_name(p)] = {{"hit", t.has_value()}, {"t", t ? t_json(*t) : nullptr}};
           // '!' marks an answer the exact verdict contradicts (boundary etc. never do).
-          const bool bad = (ans.verdict == ra::oracle::Verdict::hit && !t) ||
-                           (ans.verdict == ra::oracle::Verdict::miss && t);
+          const auto verdict = p == Precision::f32 ? ans_f.verdict : ans.verdict;
+          const bool bad = (verdict == ra::oracle::Verdict::hit && !t) || (verdict == ra::oracle::Verdict::miss && t);
           wrong += bad;
           cell += std::string(t ? "hit" : "miss") + (bad ? "!" : "") + " ";
         }
@@ -241,7 +249,9 @@ void grade(const Args& a) {
   if (!a.methods.empty()) throw ra::InputError("audit: --grade grades the answers file, not --methods: drop --methods");
   ra::OutputBatch outputs({a.json, a.csv});
   const auto ps = chosen_precisions(a.precision);
-  // Answers are double unless only float was asked for (as --export-cases).
+  // One file of answers is one precision (as --export-cases); double unless given.
+  if (a.precision_given && ps.size() != 1)
+    throw ra::InputError("--precision: --grade takes one precision (float or double), got '" + a.precision + "'");
   const Precision p = ps.size() == 1 ? ps[0] : Precision::f64;
   const std::string method = std::filesystem::path(a.grade).stem().string();
   const Report rep = grade_answers(a.grade, a.cases, p, method.empty() ? "answers" : method);
@@ -448,15 +458,23 @@ void setup(CLI::App& app) {
   cmd->add_option("--rays", a->rays,
                   "Ray/primitive tests per family per method and precision (a ray against a fan of 6 counts 6)")
       ->capture_default_str()
-      ->check(CLI::Validator(
+      ->transform(CLI::Validator(
           [](std::string& v) -> std::string {
-            if (v.empty() || v.size() > 18 || v.find_first_not_of("0123456789") != std::string::npos)
+            // Digits, or digits 'e' digits (1e6: as the limit is written).
+            const std::size_t e = v.find_first_of("eE");
+            const std::string mant = v.substr(0, e), ex = e == std::string::npos ? "" : v.substr(e + 1);
+            auto digits = [](const std::string& x) {
+              return !x.empty() && x.size() <= 18 && x.find_first_not_of("0123456789") == std::string::npos;
+            };
+            if (!digits(mant) || (e != std::string::npos && !digits(ex)))
               return "'" + v + "' is not a whole number of rays";
-            const long long n = std::stoll(v);
+            long double n = std::stold(mant);
+            for (long long k = e == std::string::npos ? 0 : std::stoll(ex); k > 0 && n <= kMaxRays; --k) n *= 10;
             if (n < 1) return "at least 1 ray";
             if (n > kMaxRays)
               return v + " is above the limit of 10000000000 (1e10) rays per family, about 30 hours of every "
                          "method on 2 cores; spread a run that size over machines with --shard K/N";
+            v = std::to_string((long long)n);  // what the option then holds: 1e6 as 1000000
             return {};
           },
           "1 to 1e10"));
@@ -500,9 +518,16 @@ void setup(CLI::App& app) {
   merge_cmd->callback([a] { merge(*a); });
   cmd->callback([a, merge_cmd, cmd] {
     if (merge_cmd->parsed()) return;
+    a->precision_given = cmd->count("--precision") > 0;
+    // Given cases are not generated: the generator's options would be ignored.
+    if (!a->cases.empty())
+      for (const char* opt : {"--rays", "--seed", "--families"})
+        if (cmd->count(opt))
+          throw ra::InputError(std::string("audit: ") + opt + " chooses generated cases; " +
+                               (a->grade.empty() ? "--cases" : "--grade") + " takes the cases of " + a->cases +
+                               ": drop " + opt);
     if (!a->grade.empty()) return grade(*a);
     if (!a->cases.empty()) return audit_cases(*a);
-    a->precision_given = cmd->count("--precision") > 0;
     if (!a->export_cases.empty()) return export_cases(*a);
     audit(*a);
   });

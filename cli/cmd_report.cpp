@@ -16,6 +16,7 @@
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
+#include "io/text_lines.h"
 #include "io/input_file.h"
 #include "registry.h"
 
@@ -141,9 +142,21 @@ void check_bench(const fs::path& f) {
   for (std::size_t i = 0; i < bs.size(); ++i) {
     const std::string at = "benchmarks[" + std::to_string(i) + "]";
     need(f, bs[i], at, "name", "string");
-    for (const char* k : {"ns_per_test", "Mrays_per_s", "ratio", "triangles"})
-      if (bs[i].contains(k) && !bs[i][k].is_number() && !bs[i][k].is_null())
-        throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is not a number");
+    // NaN and Infinity (null here) only where Google Benchmark writes them,
+    // the spread of a constant counter; a figure the page draws must be a
+    // finite number >= 0 (NaN drew nothing and a negative time a point off
+    // the chart).
+    const bool spread = bs[i].contains("aggregate_name") && bs[i]["aggregate_name"].is_string() &&
+                        (bs[i]["aggregate_name"] == "cv" || bs[i]["aggregate_name"] == "stddev");
+    for (const char* k : {"ns_per_test", "Mrays_per_s", "ratio", "triangles"}) {
+      if (!bs[i].contains(k) || (spread && bs[i][k].is_null())) continue;
+      const json& v = bs[i][k];
+      if (v.is_null())
+        throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is NaN or infinite");
+      if (!v.is_number()) throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is not a number");
+      if (!(v.get<double>() >= 0))
+        throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is negative (" + v.dump() + ")");
+    }
   }
 }
 
@@ -202,7 +215,7 @@ void check_golden(const fs::path& f) {
 void check_stages(const fs::path& f) {
   std::istringstream in(read_file(f));
   std::string line;
-  for (int n = 1; std::getline(in, line); ++n) {
+  for (int n = 1; ra::read_text_line(in, line); ++n) {  // \n, \r\n or a lone \r, as the page's Python reads it
     if (line.empty()) continue;
     const auto tab = line.rfind('\t');
     char* end = nullptr;

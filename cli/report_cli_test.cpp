@@ -93,6 +93,52 @@ TEST(ReportCli, AcceptsGoogleBenchmarksNaN) {
   fs::remove_all(d);
 }
 
+// A figure the page draws must be a finite number >= 0: NaN or Infinity
+// outside a cv/stddev row, or a negative time, is one line and exit 2 (the
+// page drew nothing, or a point off the chart, with matplotlib's warnings).
+TEST(ReportCli, NonFiniteOrNegativeFiguresAreRefused) {
+  const fs::path d = fresh_dir("nonfinite");
+  const fs::path a = small_audit(d);
+  const fs::path b = d / "bench.json";
+  const std::string head = R"({"context": {"num_cpus": 2}, "benchmarks": [
+    {"name": "kernel/moller/float/nocull/hit=50/back=0_median", "run_name": "kernel/moller/float/nocull/hit=50/back=0",
+     "run_type": "aggregate", "aggregate_name": "median", )";
+  for (const auto& [value, why] : {std::pair<std::string, std::string>{"NaN", "is NaN or infinite"},
+                                   {"Infinity", "is NaN or infinite"},
+                                   {"-3.0", "is negative"}}) {
+    std::ofstream(b) << head << "\"ns_per_test\": " << value << "}]}";
+    const auto r = run_rayaudit("report --audit " + a.string() + " --bench " + b.string() + " -o " + (d / "rep").string());
+    EXPECT_EQ(r.code, 2) << value;
+    EXPECT_EQ(r.err, b.string() + ": benchmarks[0]: 'ns_per_test' " + why + (why == "is negative" ? " (-3.0)\n" : "\n"))
+        << r.err;
+    EXPECT_FALSE(fs::exists(d / "rep"));
+  }
+  fs::remove_all(d);
+}
+
+// Stage timings saved with Windows (\r\n) or classic Mac (\r) line ends
+// are read as the page's Python reads them, and a bad one is still named
+// by its line.
+TEST(ReportCli, StagesWithAnyLineEnd) {
+  const fs::path d = fresh_dir("stages");
+  const fs::path a = small_audit(d);
+  const fs::path st = d / "stages.tsv";
+  for (const std::string eol : {"\r\n", "\r"}) {
+    std::ofstream(st, std::ios::binary) << "render\t1.5" << eol << "audit\t2" << eol;
+    fs::remove_all(d / "rep");
+    auto r = run_rayaudit("report --audit " + a.string() + " --stages " + st.string() + " -o " + (d / "rep").string());
+    ASSERT_EQ(r.code, 0) << r.all;
+    const auto rep = nlohmann::json::parse(slurp(d / "rep" / "report.json"));
+    EXPECT_NE(rep.dump().find("\"audit\""), std::string::npos);
+    std::ofstream(st, std::ios::binary) << "render\t1.5" << eol << "audit\tsoon" << eol;
+    fs::remove_all(d / "rep");
+    r = run_rayaudit("report --audit " + a.string() + " --stages " + st.string() + " -o " + (d / "rep").string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err.rfind(st.string() + ":2: ", 0), 0u) << r.err;
+  }
+  fs::remove_all(d);
+}
+
 TEST(ReportCli, WrongShapeNamesTheKeyExit2) {
   const fs::path d = fresh_dir("shape");
   const fs::path a = d / "audit.json";

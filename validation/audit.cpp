@@ -228,6 +228,18 @@ Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
   };
   read("t_ulps", s.ulp_hist);
   read("t_rel", s.rel_hist);
+  // Each maximum lies in the highest bin its histogram fills (0 without samples).
+  auto top = [](const auto& hist) {
+    int t = -1;
+    for (int i = 0; i < int(hist.size()); ++i)
+      if (hist[std::size_t(i)]) t = i;
+    return t;
+  };
+  if (s.t_samples == 0 ? s.max_ulps != 0 : ulp_bin(s.max_ulps) != top(s.ulp_hist))
+    throw std::runtime_error("stats: 't_ulps_max' " + std::to_string(s.max_ulps) +
+                             " is not in the highest bin of the 't_ulps' histogram");
+  if (s.t_samples == 0 ? s.max_rel != 0 : !(s.max_rel >= 0) || rel_bin(s.max_rel) != top(s.rel_hist))
+    throw std::runtime_error("stats: 't_rel_max' is not in the highest bin of the 't_rel' histogram");
   check_merged_stats(j, h, s);
   return s;
 }
@@ -253,8 +265,13 @@ void book(Stats& s, const oracle::Answer& a, bool hit, bool finite, T t) {
     case Verdict::coplanar: ++(hit ? s.coplanar_hits : s.coplanar_misses); break;
     case Verdict::degenerate: ++(hit ? s.degenerate_hits : s.degenerate_misses); break;
   }
-  if (!hit || !std::isfinite(t) || !(a.verdict == Verdict::hit || a.verdict == Verdict::boundary))
+  if (!hit || !(a.verdict == Verdict::hit || a.verdict == Verdict::boundary)) return;
+  // A hit at t = NaN or +-inf is off by more than any bound: wrong, and no
+  // sample of the t error (it has no finite size).
+  if (!std::isfinite(t)) {
+    ++s.wrong_t;
     return;
+  }
   const std::uint64_t ulps = ulp_distance<T>(t, T(a.t));
   const double rel = a.t != 0 ? std::abs(double(t) - a.t) / std::abs(a.t) : (t == 0 ? 0.0 : 1.0);
   ++s.t_samples;
@@ -466,9 +483,17 @@ std::vector<oracle::Answer> judge(const TriangleBatch& b) {
 
 void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given,
                  int count, bool closed) {
+  // Float answers are judged on the inputs rounded to float, as the audit's
+  // own float cases are (a no-op for cases exported in float).
+  const bool f32 = p == Precision::f32;
+  auto in_p = [f32](const Vec3d& v) { return f32 ? Vec3d(Vec3f(v)) : v; };
+  Rayd r = ray;
+  if (f32) r = Rayd(Rayf(ray));
+  std::vector<Tri> in(tris, tris + count);
+  for (Tri& t : in) t = {in_p(t.a), in_p(t.b), in_p(t.c)};
   std::vector<oracle::Answer> ans;
   ans.reserve(std::size_t(count));
-  for (int k = 0; k < count; ++k) ans.push_back(oracle::triangle(ray, tris[k].a, tris[k].b, tris[k].c));
+  for (int k = 0; k < count; ++k) ans.push_back(oracle::triangle(r, in[std::size_t(k)].a, in[std::size_t(k)].b, in[std::size_t(k)].c));
   int hits = 0;
   for (int k = 0; k < count; ++k) {
     const GivenAnswer& g = given[k];
@@ -479,7 +504,7 @@ void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const
     else
       book<double>(st, ans[std::size_t(k)], g.hit, finite_hit(TriangleHit<double>{g.t, g.u, g.v}), g.t);
   }
-  const bool proper = closed || (count > 1 && group_is_proper(tris, count, ray.d));
+  const bool proper = closed || (count > 1 && group_is_proper(in.data(), count, r.d));
   book_group(st, count, hits, count > 1 ? crossings(ans.data(), count) : 0, proper);
 }
 
@@ -689,8 +714,9 @@ nlohmann::json Report::to_json() const {
           {"semantics",
            "ray = {o + t d : max(tmin,0) <= t <= tmax}; closed triangle; inputs exact as given "
            "(float cases rounded to float before method and oracle); wrong = false hits + false "
-           "misses + hits with relative t error > 1e-2 or (spheres) nearer the far root than the near one; boundary/coplanar/degenerate answers are "
-           "counted apart, never wrong"},
+           "misses + hits with relative t error > 1e-2, t NaN or infinite, or (spheres) nearer the far root than "
+           "the near one, t judged on hit and boundary cases; hitting or missing a boundary/coplanar/degenerate "
+           "case is counted apart, never wrong"},
           {"subjects", subs},
           {"cells", cs}};
   if (shard) out["shard"] = {{"k", shard->k}, {"n", shard->n}};
@@ -779,12 +805,24 @@ std::string Report::summary_table() const {
                  : "none");
   }
   out +=
-      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = right hit, t off by > 1% or nearer a sphere's far root; "
-      "LEAKS = edge/vertex/mesh rays the exact answer hits and the method misses entirely;\n"
-      "DOUBLE = more hits than exact crossings; SELF% = spawned secondary rays re-hitting their "
-      "triangle; boundary/coplanar/degenerate cases are in the JSON, never counted wrong.\n";
+      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = a hit on a hit or boundary case with t off by > 1%, "
+      "NaN or infinite, or nearer a sphere's far root;\n"
+      "LEAKS = edge/vertex/mesh rays the exact answer hits and the method misses entirely; "
+      "DOUBLE = more hits than exact crossings; SELF% = spawned secondary rays re-hitting their triangle;\n"
+      "hitting or missing a boundary/coplanar/degenerate case is never counted wrong (its counts are in the JSON).\n";
   return out;
 }
+
+namespace {
+// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line
+// end: a subject is named after the answers file, which may hold any.
+std::string csv_field(const std::string& f) {
+  if (f.find_first_of(",\"\r\n") == std::string::npos) return f;
+  std::string q = "\"";
+  for (char ch : f) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return q + '"';
+}
+}  // namespace
 
 std::string Report::to_csv() const {
   std::ostringstream os;
@@ -795,7 +833,8 @@ std::string Report::to_csv() const {
     const Stats& s = c.stats;
     const std::string& n = subjects[c.subject];
     const auto slash = n.rfind('/');
-    os << n.substr(0, slash) << ',' << n.substr(slash + 1) << ',' << c.family << ',' << c.sweep_label
+    os << csv_field(n.substr(0, slash)) << ',' << csv_field(n.substr(slash + 1)) << ',' << csv_field(c.family) << ','
+       << csv_field(c.sweep_label)
        << ',' << s.tests << ',' << s.wrong() << ',' << s.true_hits << ',' << s.false_hits << ','
        << s.true_misses << ',' << s.false_misses << ','
        << s.wrong_t << ',' << s.boundary_hits << ',' << s.boundary_misses << ',' << s.coplanar_hits
