@@ -1,6 +1,7 @@
 // `rayaudit render SCENE -o OUT`: renders a scene file (or a bare .obj).
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <iostream>
 
 #include "io/atomic_file.h"
@@ -107,6 +108,9 @@ void run(const Args& a) {
     std::string ext = std::filesystem::path(a.out).extension().string();
     if (ext != ".png" && ext != ".exr" && ext != ".PNG" && ext != ".EXR")
       throw ra::InputError(a.out + ": output must be .png or .exr");
+    // An EXR holds the linear floats: the PNG options would be ignored.
+    if ((ext == ".exr" || ext == ".EXR") && (a.srgb || a.bits != 8))
+      throw ra::InputError(a.out + ": --srgb and --bits apply to PNG; an EXR holds the linear float values");
     // Its directory too: a missing one used to be found after the render.
     ra::declare_output(a.out);  // and not an input (the scene's textures are checked on loading)
     // And the image module that will write it (loaded now, not after the render).
@@ -117,6 +121,19 @@ void run(const Args& a) {
   if (a.height > 0) scene.height = a.height;
   if (a.width > 0 || a.height > 0) ra::apply_content_defaults(scene);
   check_work(scene, a.spp);
+  // POV-Ray's windows (the default) drop hits nearer than 1e-4 and shadow
+  // blockers within 1e-3 of a point: a scene a few thousandths across then
+  // renders black or unshadowed, which exited 0 without a word (a 1e-5
+  // quad as a bare .obj; hostile pass).
+  if (opt.self_intersection == ra::SelfIntersection::pov) {
+    const double r = ra::scene_bounds(scene).radius;
+    if (r > 0 && r < 1e-2)
+      std::fprintf(stderr,
+                   "warning: %s: the scene is %.3g across; POV-Ray's rules (--self-intersection pov, the default) "
+                   "drop hits nearer than 1e-4 and shadows within 1e-3, so it may render black or unshadowed: "
+                   "scale it up, or use --self-intersection eps or ulp-offset\n",
+                   a.scene.c_str(), 2 * r);
+  }
   // The image (12 bytes a pixel) and its encoded copies (up to 6 + 6 at
   // 16 bits), refused now rather than as a bad_alloc after the render.
   ra::check_image_memory("render", scene.width, scene.height, 24);

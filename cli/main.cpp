@@ -1,6 +1,9 @@
 // rayaudit: one program, several subcommands (each in its own cmd_*.cpp).
 // Exit codes: 0 ok, 1 a check failed, 2 bad input or usage.
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <new>
@@ -30,6 +33,20 @@ void refuse_empty_values(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands({})) refuse_empty_values(*sub);
 }
 
+// What a command printed must have arrived: `info --json > f` on a full
+// disk exited 0 and left f empty (hostile pass). Both streams are flushed
+// and checked before a success is reported.
+int finish(int code) {
+  errno = 0;
+  std::cout.flush();  // into stdio's buffer (synced), written out by the fflush
+  const bool flush_failed = std::fflush(stdout) != 0;
+  const int err = errno;  // the reason, when the failing write was this one
+  if (!(flush_failed || std::ferror(stdout) || !std::cout) || code != 0) return code;
+  std::cerr << "rayaudit: cannot write to standard output"
+            << (err ? std::string(": ") + std::strerror(err) : std::string(" (disk full, or closed)")) << "\n";
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -41,7 +58,7 @@ int main(int argc, char** argv) {
   }
   if (argc == 2 && std::string_view(argv[1]) == "--version") {
     std::cout << "rayaudit " << RAYAUDIT_VERSION << "\n";
-    return 0;
+    return finish(0);
   }
   CLI::App app{"rayaudit: is your ray-intersection code right, and how fast is it?", "rayaudit"};
   app.set_version_flag("--version", std::string("rayaudit ") + RAYAUDIT_VERSION);
@@ -67,11 +84,11 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version arrive here too, with exit code 0.
-    if (e.get_exit_code() == 0) return app.exit(e);
+    if (e.get_exit_code() == 0) return finish(app.exit(e));
     std::cerr << "rayaudit: " << e.what() << " (see --help)\n";
     return 2;
   } catch (const ra::cli::ExitCode& e) {
-    return e.code;
+    return finish(e.code);
   } catch (const ra::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;
@@ -97,5 +114,5 @@ int main(int argc, char** argv) {
     std::cerr << "rayaudit: error: " << e.what() << "\n";
     return 2;
   }
-  return 0;
+  return finish(0);
 }

@@ -118,6 +118,58 @@ TEST(ReliabilityCli, VersionEndsWithANewline) {
   EXPECT_EQ(r.out, std::string("rayaudit ") + RAYAUDIT_VERSION + "\n");
 }
 
+// What a command prints must arrive: on a full disk (/dev/full) every
+// command that writes to stdout says so in one line with exit 2; it exited
+// 0 and left `info --json > f` empty (hostile pass).
+TEST(ReliabilityCli, StdoutOnAFullDiskIsAnError) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  for (const std::string& args : std::vector<std::string>{"--version", "methods", "methods --json",
+                                                           "info " + kScenes + "/meshes/tetrahedron.obj",
+                                 "info --json " + kScenes + "/meshes/tetrahedron.obj"}) {
+    const auto r = run_rayaudit(args + " >/dev/full");
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err, "rayaudit: cannot write to standard output: No space left on device\n") << args;
+  }
+}
+
+// PNG options with an EXR output were ignored (the file identical with or
+// without them); refused as other ignored options are.
+TEST(ReliabilityCli, PngOptionsWithAnExrAreRefused) {
+  const fs::path out = scratch("png_opts.exr");
+  for (const char* opt : {"--srgb", "--bits 16"}) {
+    const auto r = run_rayaudit("render " + kScenes + "/meshes/tetrahedron.obj -o " + out.string() + " --width 8 --height 8 " + opt);
+    EXPECT_EQ(r.code, 2) << opt;
+    EXPECT_EQ(r.err, out.string() + ": --srgb and --bits apply to PNG; an EXR holds the linear float values\n") << opt;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// A 1e-5 quad as a bare .obj: POV-Ray's 1e-4 minimum depth drops every
+// camera hit, so the image is black; the render says why (it said nothing).
+// The same quad at unit size renders without a warning.
+TEST(ReliabilityCli, ASceneSmallerThanPovsWindowsIsWarnedAbout) {
+  const fs::path obj = scratch("tiny_quad.obj"), unit = scratch("unit_quad.obj"), out = scratch("tiny.png");
+  std::ofstream(obj) << "v 0 0 0\nv 1e-5 0 0\nv 0 1e-5 0\nv 1e-5 1e-5 0\nf 1 2 4 3\n";
+  std::ofstream(unit) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n";
+  auto r = run_rayaudit("render " + obj.string() + " -o " + out.string() + " --width 8 --height 8");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: " + obj.string() + ": the scene is 1.41e-05 across"), std::string::npos) << r.err;
+  r = run_rayaudit("render " + unit.string() + " -o " + out.string() + " --width 8 --height 8");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
+// A regular file where the output's directory should be is named as such
+// (it read "output directory does not exist").
+TEST(ReliabilityCli, OutputUnderARegularFileIsNamed) {
+  const fs::path file = scratch("notes.txt");
+  std::ofstream(file) << "x\n";
+  const fs::path out = file / "x.png";
+  const auto r = run_rayaudit("render " + kScenes + "/meshes/tetrahedron.obj -o " + out.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, out.string() + ": output directory " + file.string() + " is not a directory\n");
+}
+
 TEST(ReliabilityCli, ExportPovWithIniEqualToOutputIsRefused) {
   const fs::path pov = scratch("same.pov");
   std::ofstream(pov) << "precious";

@@ -365,6 +365,10 @@ struct Tracer::Impl {
     }
     m.bs_center = (lo + hi) * 0.5;
     for (const auto& p : set.positions) m.bs_radius = std::max(m.bs_radius, length(p - m.bs_center));
+    // The BVH's boxes and the bounding sphere are widened by it: a float
+    // kernel answers for the ray rounded to float, whose origin far out
+    // moves by 2^-24 of its distance (at 1e6, 0.06), so its hits can lie
+    // outside the mesh's exact sphere (hostile pass: 182 pixels lost at 1e6).
     m.pad = 1e-5 * std::max(length(hi - lo), std::max(max_component(abs(lo)), max_component(abs(hi))));
     m.lo = lo - Vec3d{m.pad, m.pad, m.pad};
     m.hi = hi + Vec3d{m.pad, m.pad, m.pad};
@@ -482,11 +486,11 @@ struct Tracer::Impl {
   // which it narrows.
   template <bool kFma, class T, class Consider>
   [[gnu::always_inline]] static inline void closest_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& window,
-                                                            int oi, Consider&& consider) {
+                                                            int oi, bool cull, Consider&& consider) {
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(window);
     walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
       moller_simd::Hit4<T> h;
-      moller_simd::hit4<kFma>(lanes, window.tmax, m.tri4[first / 4], m.cull, h);
+      moller_simd::hit4<kFma>(lanes, window.tmax, m.tri4[first / 4], cull, h);
       for (int hits = h.hits; hits; hits &= hits - 1) {
         const int l = __builtin_ctz(unsigned(hits));
         consider(double(h.t[l]), oi, int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
@@ -500,7 +504,7 @@ struct Tracer::Impl {
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(r);
     walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
       moller_simd::Hit4<T> h;
-      moller_simd::hit4<kFma>(lanes, r.tmax, m.tri4[first / 4], m.cull, h);
+      moller_simd::hit4<kFma>(lanes, r.tmax, m.tri4[first / 4], false, h);  // never culled: see closest()
       return hit = h.hits != 0;
     }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
     return hit;
@@ -515,11 +519,11 @@ struct Tracer::Impl {
   // kernels, window and tie rule, so the same hits.
   bool one_mesh_tri4 = false;
   template <class T>
-  [[gnu::always_inline]] inline std::optional<SceneHit> closest_one_mesh(const Ray<double>& rd) const {
+  [[gnu::always_inline]] inline std::optional<SceneHit> closest_one_mesh(const Ray<double>& rd, bool cull) const {
     SceneHit best;
     best.t = std::numeric_limits<double>::infinity();
     Ray<T> window(rd);
-    closest_in_tri4<true>(meshes<T>()[0], false, window, 0,
+    closest_in_tri4<true>(meshes<T>()[0], false, window, 0, cull && meshes<T>()[0].cull,
                           [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
                             if (nearer(t, obj, prim, best)) {
                               best = {t, obj, prim, b1, b2};
@@ -530,8 +534,9 @@ struct Tracer::Impl {
     return best;
   }
   template <class T>
-  [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_one_mesh_avx2(const Ray<double>& rd) const {
-    return closest_one_mesh<T>(rd);
+  [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_one_mesh_avx2(const Ray<double>& rd,
+                                                                                            bool cull) const {
+    return closest_one_mesh<T>(rd, cull);
   }
   template <class T>
   [[gnu::target("avx2,fma"), gnu::noinline]] bool occluded_one_mesh_avx2(const Ray<T>& r) const {
@@ -543,8 +548,8 @@ struct Tracer::Impl {
   bool avx512 = false;
   template <class T>
   [[gnu::target("avx2,fma,avx512f,avx512vl,avx512dq,avx512bw"), gnu::noinline]] std::optional<SceneHit>
-  closest_one_mesh_avx512(const Ray<double>& rd) const {
-    return closest_one_mesh<T>(rd);
+  closest_one_mesh_avx512(const Ray<double>& rd, bool cull) const {
+    return closest_one_mesh<T>(rd, cull);
   }
   template <class T>
   [[gnu::target("avx2,fma,avx512f,avx512vl,avx512dq,avx512bw"), gnu::noinline]] bool occluded_one_mesh_avx512(
@@ -561,7 +566,7 @@ struct Tracer::Impl {
   // the scenes without one (one mesh: every extra traversal inlined here
   // cost 7% on primary rays).
   template <class T, bool kFma, bool kObjects = false>
-  [[gnu::always_inline]] inline std::optional<SceneHit> closest_impl(const Ray<double>& rd, int only = -1) const {
+  [[gnu::always_inline]] inline std::optional<SceneHit> closest_impl(const Ray<double>& rd, int only, bool cull) const {
     const Ray<T> r(rd);
     SceneHit best;
     best.t = std::numeric_limits<double>::infinity();
@@ -596,12 +601,12 @@ struct Tracer::Impl {
           }
           if (opt.accel == Accel::bvh) {
             if (!m.tri4.empty()) {
-              closest_in_tri4<kFma>(m, boxed, window, int(oi), consider);
+              closest_in_tri4<kFma>(m, boxed, window, int(oi), cull && m.cull, consider);
               break;
             }
             walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
               for (std::uint32_t slot = first; slot < first + count; ++slot)
-                if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, m.cull))
+                if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, cull && m.cull))
                   consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
               return false;
             });
@@ -609,11 +614,11 @@ struct Tracer::Impl {
           }
           if (opt.accel == Accel::sphere &&
               !segment_meets_ball(Ray<double>{rd.o, rd.d, double(window.tmin), double(window.tmax)},
-                                  m.bs_center, m.bs_radius))
+                                  m.bs_center, m.bs_radius + m.pad))
             break;
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
-            if (auto h = k.hit_pre(window, m.pre.data() + i * m.stride, m.cull))
+            if (auto h = k.hit_pre(window, m.pre.data() + i * m.stride, cull && m.cull))
               consider(double(h->t), int(oi), int(i), double(h->b1), double(h->b2));
           break;
         }
@@ -749,7 +754,7 @@ struct Tracer::Impl {
             } else {
               walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                 for (std::uint32_t slot = first; slot < first + count; ++slot)
-                  if (k.any_pre(r, m.pre.data() + slot * m.stride, m.cull)) return hit = true;
+                  if (k.any_pre(r, m.pre.data() + slot * m.stride, false)) return hit = true;
                 return false;
               });
             }
@@ -757,11 +762,11 @@ struct Tracer::Impl {
             break;
           }
           if (opt.accel == Accel::sphere &&
-              !segment_meets_ball(static_cast<Ray<double>>(r), m.bs_center, m.bs_radius))
+              !segment_meets_ball(static_cast<Ray<double>>(r), m.bs_center, m.bs_radius + m.pad))
             break;
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
-            if (k.any_pre(r, m.pre.data() + i * m.stride, m.cull)) return true;
+            if (k.any_pre(r, m.pre.data() + i * m.stride, false)) return true;
           break;
         }
       }
@@ -812,27 +817,35 @@ struct Tracer::Impl {
   // `only` >= 0 restricts the search to that one object (POV-Ray's shadow
   // cache asks about the object that shadowed the previous pixel).
   template <class T>
-  [[gnu::noinline]] std::optional<SceneHit> closest_objects_base(const Ray<double>& rd) const {
-    return closest_impl<T, false, true>(rd);
+  [[gnu::noinline]] std::optional<SceneHit> closest_objects_base(const Ray<double>& rd, bool cull) const {
+    return closest_impl<T, false, true>(rd, -1, cull);
   }
   template <class T>
-  [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_objects_avx2(const Ray<double>& rd) const {
-    return closest_impl<T, true, true>(rd);
+  [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_objects_avx2(const Ray<double>& rd,
+                                                                                           bool cull) const {
+    return closest_impl<T, true, true>(rd, -1, cull);
   }
   template <class T>
-  std::optional<SceneHit> closest_base(const Ray<double>& rd, int only) const {
-    if (only < 0 && object_bvh_for(rd.o)) return closest_objects_base<T>(rd);
-    return closest_impl<T, false>(rd, only);
+  std::optional<SceneHit> closest_base(const Ray<double>& rd, int only, bool cull) const {
+    if (only < 0 && object_bvh_for(rd.o)) return closest_objects_base<T>(rd, cull);
+    return closest_impl<T, false>(rd, only, cull);
   }
   template <class T>
-  [[gnu::target("avx2,fma")]] std::optional<SceneHit> closest_avx2(const Ray<double>& rd, int only) const {
-    if (only < 0 && object_bvh_for(rd.o)) return closest_objects_avx2<T>(rd);
-    return closest_impl<T, true>(rd, only);
+  [[gnu::target("avx2,fma")]] std::optional<SceneHit> closest_avx2(const Ray<double>& rd, int only, bool cull) const {
+    if (only < 0 && object_bvh_for(rd.o)) return closest_objects_avx2<T>(rd, cull);
+    return closest_impl<T, true>(rd, only, cull);
   }
+  // `cull`: --cull applies to this ray (a camera ray). Culling a closed,
+  // outward-wound mesh changes nothing only for rays from outside it: a
+  // shadow or reflected ray leaving a smooth-shaded point near the
+  // terminator can run into the mesh (its shading normal faces the light,
+  // its geometric normal away), where culled back faces let it through
+  // (a lit seam; hostile pass). Secondary rays are never culled.
   template <class T>
-  std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1) const {
-    if (one_mesh_tri4 && only <= 0) return avx512 ? closest_one_mesh_avx512<T>(rd) : closest_one_mesh_avx2<T>(rd);
-    return avx2 ? closest_avx2<T>(rd, only) : closest_base<T>(rd, only);
+  std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1, bool cull = false) const {
+    if (one_mesh_tri4 && only <= 0)
+      return avx512 ? closest_one_mesh_avx512<T>(rd, cull) : closest_one_mesh_avx2<T>(rd, cull);
+    return avx2 ? closest_avx2<T>(rd, only, cull) : closest_base<T>(rd, only, cull);
   }
   template <class T>
   [[gnu::noinline]] bool occluded_objects_base(const Ray<T>& r) const { return occluded_impl<T, false, true>(r); }
@@ -856,8 +869,8 @@ struct Tracer::Impl {
     return avx2 ? occluded_avx2<T>(r) : occluded_base<T>(r);
   }
 
-  std::optional<SceneHit> intersect(const Ray<double>& r) const {
-    return opt.use_double ? closest<double>(r) : closest<float>(r);
+  std::optional<SceneHit> intersect(const Ray<double>& r, bool camera) const {
+    return opt.use_double ? closest<double>(r, -1, camera) : closest<float>(r, -1, camera);
   }
 
   // The surface at a hit: point, geometric and shading normals, material,
@@ -1051,22 +1064,22 @@ struct Tracer::Impl {
   // through the rounding of its origin) is skipped when it is nearer than
   // that rounding allows: the origin's error along the normal (16 ulps of
   // its largest coordinate) over the ray's cosine with the normal.
-  std::optional<SceneHit> intersect_from(Ray<double> ray, const Surface* from) const {
-    auto hit = intersect(ray);
+  std::optional<SceneHit> intersect_from(Ray<double> ray, const Surface* from, bool camera) const {
+    auto hit = intersect(ray, camera);
     if (!opt.skip_rounding_self_hits || !from) return hit;
     while (hit && hit->object == from->object && hit->prim == from->prim) {
       const double cos = std::abs(dot(from->ng, normalize(ray.d)));
       const double bound = 16 * std::numeric_limits<double>::epsilon() * max_component(abs(ray.o)) / cos;
       if (!(hit->t < bound)) break;
       ray.tmin = std::nextafter(hit->t, std::numeric_limits<double>::infinity());
-      hit = intersect(ray);
+      hit = intersect(ray, camera);
     }
     return hit;
   }
 
   Color trace(const Ray<double>& ray, int level, double weight, const Surface* from = nullptr) const {
     if (level > scene.max_depth) return {0, 0, 0};
-    const auto hit = intersect_from(ray, from);
+    const auto hit = intersect_from(ray, from, level == 1 && !from);
     if (!hit) return scene.background;
     Surface s = surface(ray, *hit);
     const Vec3d d = normalize(ray.d);
@@ -1159,13 +1172,13 @@ Tracer::Tracer(const Scene& scene, const RenderOptions& options)
 Tracer::~Tracer() = default;
 
 Color Tracer::trace(const Ray<double>& ray) const { return impl_->trace(ray, 1, 1.0); }
-std::optional<SceneHit> Tracer::intersect(const Ray<double>& ray) const { return impl_->intersect(ray); }
+std::optional<SceneHit> Tracer::intersect(const Ray<double>& ray) const { return impl_->intersect(ray, true); }
 bool Tracer::occluded(const Ray<double>& ray) const {
   return impl_->opt.use_double ? impl_->occluded<double>(ray) : impl_->occluded<float>(static_cast<Ray<float>>(ray));
 }
 Color Tracer::pixel(int i, int j) const { return impl_->pixel(i, j); }
 std::optional<Tracer::ShadingPoint> Tracer::shading_point(const Ray<double>& ray) const {
-  const auto hit = impl_->intersect(ray);
+  const auto hit = impl_->intersect(ray, true);
   if (!hit) return std::nullopt;
   Impl::Surface s = impl_->surface(ray, *hit);
   impl_->bump_document(s);

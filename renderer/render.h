@@ -90,7 +90,9 @@ class Tracer {
 
   // The colour seen along a camera ray (level 1).
   Color trace(const Ray<double>& ray) const;
-  // The closest hit of a ray, if any (the ray's own window applies).
+  // The closest hit of a ray, if any (the ray's own window applies), as a
+  // camera ray: --cull applies (the renderer never culls shadow or
+  // reflected rays, which may start inside a closed mesh's silhouette).
   std::optional<SceneHit> intersect(const Ray<double>& ray) const;
   // Is anything in the ray's window? (what shadow rays ask), in the chosen
   // precision.

@@ -106,6 +106,31 @@ double luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722
 
 }  // namespace
 
+std::string float32_colour_cause(const float* ours, const float* pov, unsigned max) {
+  // Every channel that differs is one level apart, and ours lies within a
+  // few float32 ulps of the boundary between the two levels, k + 0.5 (a hit
+  // against a miss, or a channel two levels off, is not this).
+  int near_ch = -1;
+  double near_scaled = 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    const float v = ours[ch];
+    const unsigned qo = quantize(v, max), qp = quantize(pov[ch], max);
+    if (qo == qp) continue;
+    const double scaled = double(v) * max;
+    const double boundary = std::min(qo, qp) + 0.5;
+    const double ulp = double(std::nextafter(v, 2.f) - v) * max;
+    if (!(qo + 1 == qp || qp + 1 == qo) || !(std::abs(scaled - boundary) <= 4 * ulp)) return {};
+    near_ch = ch, near_scaled = scaled;
+  }
+  if (near_ch < 0) return {};
+  char buf[300];
+  std::snprintf(buf, sizeof buf,
+                "float32 colour: our channel %d is %.9g levels, within 4 float32 ulps of a rounding boundary "
+                "(k + 0.5); POV-Ray computes colours in float32, so its value falls on the other side",
+                near_ch, near_scaled);
+  return buf;
+}
+
 std::vector<PixelExplanation> explain_differences(const Scene& scene, const Image& ours, const Image& pov,
                                                   const ImageComparison& c, const RenderOptions& options) {
   std::vector<PixelExplanation> out;
@@ -209,23 +234,8 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
         same &= quantize(cache_images[ci]->at(d.x, d.y)[ch], m) == quantize(pov.at(d.x, d.y)[ch], m);
       if (same) e.cause = cache_models[ci].cause;
     }
-    if (e.cause.empty() && !is_skipped(skip, "float32 colour")) {
-      // Our value within a few float32 ulps of a rounding boundary (k + 0.5) / max.
-      for (int ch = 0; ch < 3 && e.cause.empty(); ++ch) {
-        const float v = ours.at(d.x, d.y)[ch];
-        const double scaled = double(v) * m;
-        const double boundary = std::floor(scaled) + 0.5;
-        const double ulp = double(std::nextafter(v, 2.f) - v) * m;
-        if (std::abs(scaled - boundary) <= 4 * ulp || std::abs(scaled - (boundary - 1)) <= 4 * ulp) {
-          char buf[300];
-          std::snprintf(buf, sizeof buf,
-                        "float32 colour: our channel %d is %.9g levels, within 4 float32 ulps of a rounding boundary "
-                        "(k + 0.5); POV-Ray computes colours in float32, so its value falls on the other side",
-                        ch, scaled);
-          e.cause = buf;
-        }
-      }
-    }
+    if (e.cause.empty() && !is_skipped(skip, "float32 colour"))
+      e.cause = float32_colour_cause(ours.at(d.x, d.y), pov.at(d.x, d.y), m);
     if (!e.cause.empty()) {
       out.push_back(e);
       continue;

@@ -48,6 +48,11 @@ struct PixelExplanation {
   std::string cause;  // empty: none of the known causes
 };
 
+// The "float32 colour" cause of one pixel (3 channels in 0..1; max levels), or
+// empty: every channel that differs is one level off, and ours lies within
+// 4 float32 ulps of the boundary between the two levels.
+std::string float32_colour_cause(const float* ours, const float* pov, unsigned max);
+
 std::vector<PixelExplanation> explain_differences(const Scene& scene, const Image& ours, const Image& pov,
                                                   const ImageComparison& c, const RenderOptions& options);
 

@@ -19,6 +19,26 @@
 namespace ra {
 namespace {
 
+// The float32 colour cause explains a pixel only where every channel that
+// differs is one level off and ours lies at k + 0.5 within float32 ulps:
+// 0.1f is 25.5000004 levels, so POV's float32 25 is explained; a hit
+// against POV's black background (26 levels) or a blue channel 25 levels
+// off beside two equal ones is not (it once was: any channel of ours near
+// a boundary sufficed), nor is one level off far from a boundary.
+TEST(PovExplain, Float32ColourNeedsOneLevelAtARoundingBoundary) {
+  const float tenth[3] = {0.1f, 0.1f, 0.1f};
+  const float pov25[3] = {25 / 255.f, 25 / 255.f, 25 / 255.f};
+  const float black[3] = {0, 0, 0};
+  const float blue_off[3] = {26 / 255.f, 26 / 255.f, 51 / 255.f};
+  EXPECT_NE(float32_colour_cause(tenth, pov25, 255).find("float32 colour"), std::string::npos);
+  EXPECT_EQ(float32_colour_cause(tenth, black, 255), "");
+  EXPECT_EQ(float32_colour_cause(tenth, blue_off, 255), "");
+  const float fifth[3] = {0.2f, 0.2f, 0.2f};  // 51.0000007 levels: no boundary near
+  const float pov52[3] = {52 / 255.f, 52 / 255.f, 52 / 255.f};
+  EXPECT_EQ(float32_colour_cause(fifth, pov52, 255), "");
+  EXPECT_EQ(float32_colour_cause(tenth, tenth, 255), "") << "nothing differs";
+}
+
 TEST(PovExplain, CornellBoxEdgePixelIsPovsMeshInsideTest) {
   try {
     find_povray();

@@ -117,6 +117,23 @@ TEST(PovExport, RefusesTheDocumentsOwnBumpVariants) {
   EXPECT_FALSE(pov_inexpressible(s).has_value());
 }
 
+// POV-Ray's image maps hold 8 or 16-bit integers: a texture stored as
+// floats (an EXR) would be rounded, and clamped to [0, 1], by the export's
+// PNG copy; such a scene is inexpressible, the same texture as a PNG is not.
+TEST(PovExport, FloatTexturesAreInexpressible) {
+  const fs::path dir = fresh_dir("floattex");
+  Image img(4, 4);
+  for (auto& v : img.rgb) v = 2.5f;
+  write_image(dir / "bright.exr", img);
+  write_png(dir / "plain.png");
+  const auto reason = pov_inexpressible(textured_quad(dir / "bright.exr"));
+  ASSERT_TRUE(reason.has_value());
+  EXPECT_NE(reason->find("stores floating-point values"), std::string::npos) << *reason;
+  EXPECT_THROW(export_pov(textured_quad(dir / "bright.exr")), InputError);
+  EXPECT_FALSE(pov_inexpressible(textured_quad(dir / "plain.png")).has_value());
+  fs::remove_all(dir);
+}
+
 // The texture's file name is SDL that opens and writes a file. The exporter
 // must not let it through, and POV-Ray run on the export must not create the
 // file. The control proves the payload is live: the same name written naively

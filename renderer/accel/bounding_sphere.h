@@ -1,8 +1,9 @@
 // Document 002's bounding-sphere test (seeds/002: skip a mesh whose
 // bounding sphere the ray misses), the optimisation `--accel sphere` measures.
 // Guarantee: conservative, inflated by a relative 1e-6 (and 1e-12 of the
-// centre's distance from the origin), so it never rejects a mesh the ray
-// could hit within its window.
+// centre's distance from the origin), so it never rejects a mesh the exact
+// ray could hit within its window; the tracer adds its kernels' rounding
+// to the radius (render.cpp: the BVH's padding, which covers float rays).
 #pragma once
 #include <algorithm>
 #include <cmath>

@@ -17,6 +17,7 @@
 //   empty_mat.obj), so refusing it would refuse real exporter output.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <unordered_set>
 
@@ -74,6 +75,7 @@ struct MtlParser {
     }
     double x[3];
     const int n = parse_numbers(p, se, x, 3, w, line, what);
+    bounded(x, n, line, what);
     if (n == 1)
       c = {x[0], x[0], x[0]};
     else if (n == 3)
@@ -82,10 +84,22 @@ struct MtlParser {
       w.fail(line, std::string(what) + " needs 1 or 3 values (" + std::to_string(n) + " given)");
   }
 
-  double scalar(const char* p, const char* se, long line, const char* what) {
+  // `bound`: refuse magnitudes above 1e30 (illum has its own 0..1000 rule).
+  double scalar(const char* p, const char* se, long line, const char* what, bool bound = true) {
     double x;
     if (parse_numbers(p, se, &x, 1, w, line, what) != 1) w.fail(line, std::string(what) + " needs a value");
+    if (bound) bounded(&x, 1, line, what);
     return x;
+  }
+  // As a scene's numbers (scene.cpp): a Kd of 1e308 overflowed the shading
+  // to +inf, reported as a reflection problem of the render (hostile pass).
+  void bounded(const double* x, int n, long line, const char* what) {
+    for (int i = 0; i < n; ++i)
+      if (!(std::abs(x[i]) <= 1e30)) {
+        char num[32];
+        std::snprintf(num, sizeof num, "%.6g", x[i]);
+        w.fail(line, std::string(what) + " value " + num + " has a magnitude above 1e30");
+      }
   }
 
   // True when the token at p is a number (for the optional values of -o -s -t).
@@ -171,7 +185,10 @@ struct MtlParser {
       return;
     }
     MtlMaterial& m = out.back();
-    if (kw(k, p, "Ka")) return color(m.Ka, p, se, line, "Ka");
+    if (kw(k, p, "Ka")) {
+      m.Ka_at = located(name, line, "Ka");
+      return color(m.Ka, p, se, line, "Ka");
+    }
     if (kw(k, p, "Kd")) return color(m.Kd, p, se, line, "Kd");
     if (kw(k, p, "Ks")) return color(m.Ks, p, se, line, "Ks");
     if (kw(k, p, "Ns")) return void(m.Ns = scalar(p, se, line, "Ns"));
@@ -187,7 +204,7 @@ struct MtlParser {
       return;
     }
     if (kw(k, p, "illum")) {
-      const double v = scalar(p, se, line, "illum");
+      const double v = scalar(p, se, line, "illum", false);
       if (!(v >= 0 && v <= 1000) || v != std::floor(v)) w.fail(line, "illum needs an integer 0..1000");
       m.illum = int(v);
       return;

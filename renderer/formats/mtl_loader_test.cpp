@@ -126,6 +126,8 @@ TEST(MtlRegression, FuzzIllumHugeValue) {
   ss << f.rdbuf();
   EXPECT_EQ(error_of(ss.str()), "m.mtl:3: illum needs an integer 0..1000");
   EXPECT_EQ(error_of("newmtl a\nillum 1e300\n"), "m.mtl:2: illum needs an integer 0..1000");
+  EXPECT_EQ(error_of("newmtl a\nKd 1e308 1 1\n"), "m.mtl:2: Kd value 1e+308 has a magnitude above 1e30");
+  EXPECT_EQ(error_of("newmtl a\nNs -2e30\n"), "m.mtl:2: Ns value -2e+30 has a magnitude above 1e30");
   EXPECT_EQ(error_of("newmtl a\nillum 2.5\n"), "m.mtl:2: illum needs an integer 0..1000");
 }
 

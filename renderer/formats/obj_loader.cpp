@@ -34,7 +34,9 @@
 // one of the first error in the file, as in serial mode.
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -631,6 +633,17 @@ struct ChunkParser {
     const int n = parse_numbers(p, se, x, 7, w, line, "v");
     if (n != 3 && n != 4 && n != 6)
       w.fail(line, "v needs x y z, x y z w or x y z r g b (" + std::to_string(n) + " values given)");
+    // As a scene's numbers (scene.cpp): beyond 1e30 a coordinate's square
+    // overflows the kernels' products, and a 1e80 triangle rendered as
+    // ambient only, from 1e120 black, with exit 0 (hostile pass).
+    for (int k = 0; k < 3; ++k)
+      if (!(std::abs(x[k]) <= 1e30))
+      {
+        char num[32];
+        std::snprintf(num, sizeof num, "%.6g", x[k]);
+        w.fail(line, std::string("v: coordinate ") + num + " has a magnitude above 1e30 (its square would overflow "
+                     "a double's products)");
+      }
     put_position({x[0], x[1], x[2]});
   }
   // vt u [v [w]]

@@ -390,6 +390,9 @@ TEST(ObjNumbers, NonFiniteAndMalformedAreErrors) {
   EXPECT_EQ(load_error("v 1 2 0x10\n"), "t.obj:1: malformed number '0x10'");
   EXPECT_EQ(load_error("v 1 2 +-3\n"), "t.obj:1: malformed number '+-3'");
   EXPECT_EQ(load_error("v 1 2 1e400\n"), "t.obj:1: number out of range '1e400'");
+  EXPECT_EQ(load_error("v 0 0 0\nv 1e80 0 0\n"),
+            "t.obj:2: v: coordinate 1e+80 has a magnitude above 1e30 (its square would overflow a double's products)");
+  EXPECT_EQ(load_error("v 0 -1.5e30 0\n").rfind("t.obj:1: v: coordinate -1.5e+30 has a magnitude above 1e30", 0), 0u);
   EXPECT_EQ(load_error("v 1 2\n"), "t.obj:1: v needs x y z, x y z w or x y z r g b (2 values given)");
 }
 

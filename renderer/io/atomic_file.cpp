@@ -101,8 +101,11 @@ void check_output_path(const std::filesystem::path& path) {
   check_output_name(path);
   if (!fs::is_directory(dir, ec)) {
     // A symlink loop or an unreadable parent is not "does not exist".
-    if (ec && ec != std::errc::no_such_file_or_directory)
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
       throw InputError(located(path.string(), 0, "output directory: " + ec.message()));
+    // A file where the directory should be (`-o notes.txt/x.png`) is not "does not exist".
+    if (fs::exists(dir, ec))
+      throw InputError(located(path.string(), 0, "output directory " + dir.string() + " is not a directory"));
     throw InputError(located(path.string(), 0, "output directory does not exist"));
   }
   // An existing output that is not a regular file is refused: the renamed

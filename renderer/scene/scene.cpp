@@ -305,7 +305,11 @@ Scene parse_scene_json(const std::string& text, const std::filesystem::path& fil
     s.camera.up = c.vec3("up", s.camera.up);
     s.camera.vfov = c.number("vfov", s.camera.vfov);
     if (!(s.camera.vfov > 0 && s.camera.vfov < 180)) c.fail(c.at("vfov"), "must be between 0 and 180 degrees");
-    if (s.camera.position == s.camera.look_at) c.fail(c.at("look_at"), "must differ from the position");
+    // POV-Ray's rule (parse.cpp: |look_at - location|^2 < EPSILON = 1e-10 is
+    // "Camera location and look_at point must be different"): a camera 1e-6
+    // from its look_at rendered here and failed there (hostile pass).
+    if (!(dot(s.camera.look_at - s.camera.position, s.camera.look_at - s.camera.position) >= 1e-10))
+      c.fail(c.at("look_at"), "must be at least 1e-5 from the position (POV-Ray refuses a nearer one)");
     if (length(cross(s.camera.look_at - s.camera.position, s.camera.up)) == 0)
       c.fail(c.at("up"), "must not be parallel to the viewing direction");
     c.finish();

@@ -21,16 +21,19 @@ Material material_from_mtl(const MtlMaterial& m, std::vector<std::string>* warni
   Material out;
   out.color = m.Kd;
   out.diffuse = 1;
+  std::string dropped;  // the channels whose Ka has no Kd to scale (one warning for all)
   for (int c = 0; c < 3; ++c) {
     if (m.Kd[c] > 0) {
       out.ambient[c] = m.Ka[c] / m.Kd[c];
     } else {
       out.ambient[c] = 0;
-      if (m.Ka[c] > 0 && warnings)
-        warnings->push_back("material \"" + m.name +
-                            "\": Ka without Kd in a channel cannot be expressed as POV ambient; dropped");
+      if (m.Ka[c] > 0) dropped += std::string(dropped.empty() ? "" : ", ") + "rgb"[c];
     }
   }
+  if (!dropped.empty() && warnings)
+    warnings->push_back((m.Ka_at.empty() ? std::string("Ka") : m.Ka_at) + " of material \"" + m.name +
+                        "\": no Kd in channel " + dropped +
+                        ", so POV's ambient (a multiple of the pigment) cannot express it; dropped");
   out.phong = (m.Ks.x + m.Ks.y + m.Ks.z) / 3;
   out.phong_size = m.Ns;
   if (!m.map_Kd.empty() && std::filesystem::exists(m.map_Kd))
@@ -107,6 +110,27 @@ std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {
     out.material = place.material_override ? 0 : (t.material >= 0 ? t.material : fallback);
     set->triangles.push_back(out);
   }
+  // A `vn 0 0 0` has no direction: a face using one takes the normals
+  // computed from the mesh, as a face without vn does. Here, so that the
+  // tracer and the POV-Ray export (which both read these triangles) agree;
+  // it was accepted silently and rendered 2,557 pixels unlike POV-Ray.
+  long zero_faces = 0, first_zero = -1;
+  for (auto& t : set->triangles) {
+    bool zero = false;
+    for (int k = 0; k < 3; ++k)
+      if (t.n[k] >= 0 && set->normals[std::size_t(t.n[k])] == Vec3d{0, 0, 0}) {
+        zero = true;
+        if (first_zero < 0) first_zero = t.n[k];
+      }
+    if (zero) {
+      ++zero_faces;
+      t.n[0] = t.n[1] = t.n[2] = -1;
+    }
+  }
+  if (zero_faces)
+    warnings.push_back(set->name + ": " + std::to_string(zero_faces) + " triangle(s) use a zero-length vn (the " +
+                       std::to_string(first_zero + 1) + "th vn first); they take normals computed from the mesh, "
+                       "as triangles without vn do");
   for (const auto& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   return set;
 }
