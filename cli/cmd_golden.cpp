@@ -99,6 +99,17 @@ void check(const Args& a) {
   if (names.empty())
     throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
                          ": no golden images to check");
+  // A name that is neither a scene nor a golden is refused before any render
+  // (it was found after rendering the others; hostile pass). A golden whose
+  // scene is gone is a failed check, reported in its turn.
+  {
+    const auto known = set.all_names();  // sorted: scenes/ and the manifest's entries
+    for (const auto& n : names) {
+      const std::filesystem::path scene = std::filesystem::path(a.root) / "scenes" / (n + ".json");
+      if (!std::filesystem::exists(scene) && !std::binary_search(known.begin(), known.end(), n))
+        throw ra::InputError(ra::located(scene.string(), 0, "no such file, and no golden of that name"));
+    }
+  }
   // Every image a failure may write, declared before the work: the golden
   // itself (--diff-dir ROOT/golden replaced it with this render, and the
   // next check passed), --json, or another scene's inputs are refused. In a
@@ -135,7 +146,9 @@ void check(const Args& a) {
     if (later.erase(std::filesystem::absolute(out).lexically_normal())) outputs.add(out);
   };
   for (const auto& n : names) {
-    const auto missing = ra::missing_cache_inputs(std::filesystem::path(a.root) / "scenes" / (n + ".json"));
+    const std::filesystem::path scene_file = std::filesystem::path(a.root) / "scenes" / (n + ".json");
+    const auto missing = std::filesystem::exists(scene_file) ? ra::missing_cache_inputs(scene_file)
+                                                             : std::vector<std::filesystem::path>{};
     if (a.skip_unavailable && !missing.empty()) {
       const std::string why = "needs " + missing[0].string() +
                               ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)";

@@ -102,6 +102,20 @@ TEST_F(GoldenDataCli, CheckEndingInABadSceneWritesNothing) {
   EXPECT_TRUE(fs::is_empty(root / "out"));
 }
 
+// A name that is neither a scene nor a golden is refused before any render
+// (a was rendered first, then exit 2); a golden whose scene is gone is a
+// failed check in its turn, not an error.
+TEST_F(GoldenDataCli, UnknownSceneIsRefusedBeforeTheWork) {
+  auto r = run_rayaudit("golden check b nosuch --root " + root.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.out, "") << "refused before rendering";
+  EXPECT_EQ(r.err, (root / "scenes" / "nosuch.json").string() + ": no such file, and no golden of that name\n");
+  fs::remove(root / "scenes" / "a.json");
+  r = run_rayaudit("golden check a --root " + root.string());
+  EXPECT_EQ(r.code, 1) << r.all;
+  EXPECT_NE(r.out.find("is gone but its golden remains"), std::string::npos) << r.out;
+}
+
 // The same into a diff folder that is not there yet: the check makes it for
 // a's images, then exits 2 on b; the new folders are removed again.
 TEST_F(GoldenDataCli, CheckEndingInABadSceneLeavesNoNewDiffFolder) {

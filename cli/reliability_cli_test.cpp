@@ -243,6 +243,21 @@ TEST(ReliabilityCli, ConvertRefusesANanCoordinate) {
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, ply.string() + ":10: vertex 0 has coordinate nan (not finite)\n");
   EXPECT_FALSE(fs::exists(out));
+  // Nor a coordinate beyond 1e30, which the OBJ reader refuses too (PLY and OFF).
+  std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                        "0 0 0\n1e31 0 0\n0 1 0\n3 0 1 2\n";
+  auto big = run_rayaudit("convert " + ply.string() + " -o " + out.string());
+  EXPECT_EQ(big.code, 2);
+  EXPECT_EQ(big.err.rfind(ply.string() + ":11: vertex 1 has coordinate ", 0), 0u) << big.err;  // 1e31 as a float
+  EXPECT_NE(big.err.find("(magnitude above 1e30)\n"), std::string::npos) << big.err;
+  EXPECT_FALSE(fs::exists(out));
+  const fs::path off = scratch("big.off");
+  std::ofstream(off) << "OFF\n3 1 0\n0 0 0\n1e31 0 0\n0 1 0\n3 0 1 2\n";
+  big = run_rayaudit("convert " + off.string() + " -o " + out.string());
+  EXPECT_EQ(big.code, 2);
+  EXPECT_EQ(big.err.rfind(off.string() + ":4: coordinate with a magnitude above 1e30", 0), 0u) << big.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace

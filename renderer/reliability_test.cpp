@@ -204,6 +204,32 @@ TEST(Triangulate, ConvexPolygonOf300kCornersIsAFan) {
   EXPECT_NEAR(area2d(p, out), 0.5 * n * std::sin(2 * M_PI / n), 1e-9);
 }
 
+// A star whose inner corners lie at 1% of its radius (hostile pass): they
+// shared one or two cells of a grid over the whole polygon, so every
+// spike's ear scanned all of them, the work limit was spent and the fan
+// came out 118 times the star's area. The grid over the reflex corners
+// alone tiles it exactly: its area, by the shoelace formula.
+TEST(Triangulate, StarWithClusteredInnerCornersTilesExactly) {
+  for (int n : {1000, 2000, 5000}) {
+    std::vector<Vec3d> p(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      const double t = 2 * M_PI * i / n, r = i % 2 ? 0.01 : 1.0;
+      p[size_t(i)] = {r * std::cos(t), r * std::sin(t), 0};
+    }
+    double shoelace = 0;
+    for (int i = 0; i < n; ++i) {
+      const Vec3d& a = p[size_t(i)];
+      const Vec3d& b = p[size_t((i + 1) % n)];
+      shoelace += a.x * b.y - b.x * a.y;
+    }
+    std::vector<std::array<int, 3>> out;
+    EarClipScratch s;
+    EXPECT_FALSE(triangulate_polygon(p.data(), n, out, s)) << n << ": within the work limit";
+    ASSERT_EQ(out.size(), size_t(n - 2));
+    EXPECT_NEAR(area2d(p, out), 0.5 * shoelace, 1e-12) << n;
+  }
+}
+
 // A star of 200k corners (half of them reflex): quadratic before (44 s);
 // the work limit keeps it linear while every triangle keeps the winding
 // count (n - 2 triangles).

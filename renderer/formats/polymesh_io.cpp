@@ -336,6 +336,9 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
           const double v = value(pr.type);
           if ((int(i) == ix || int(i) == iy || int(i) == iz) && !std::isfinite(v))
             fail("vertex " + std::to_string(r) + " has coordinate " + number_text(v) + " (not finite)");
+          // As the OBJ reader does: the converted file must load (hostile pass).
+          if ((int(i) == ix || int(i) == iy || int(i) == iz) && !(std::abs(v) <= 1e30))
+            fail("vertex " + std::to_string(r) + " has coordinate " + number_text(v) + " (magnitude above 1e30)");
           if (int(i) == ix) pos.x = v;
           if (int(i) == iy) pos.y = v;
           if (int(i) == iz) pos.z = v;
@@ -443,6 +446,8 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
     p.y = t.number_on_line<double>("y coordinate");
     p.z = t.number_on_line<double>("z coordinate");
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) t.fail("coordinate not finite");
+    if (!(std::abs(p.x) <= 1e30 && std::abs(p.y) <= 1e30 && std::abs(p.z) <= 1e30))
+      t.fail("coordinate with a magnitude above 1e30 (the OBJ reader refuses it)");
     check_off_extras(t, extras, magic);
     m.positions.push_back(p);
     t.next_line();

@@ -65,12 +65,21 @@ bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
   // Only a corner that is not convex can lie inside an ear (Meisters), so
   // only those are tested, found through a uniform grid of about one cell
   // each: a convex polygon costs O(n), a small ear O(1) tests.
+  // The grid spans the reflex corners alone: an ear's box is clamped to it
+  // (the clamped cells still hold every reflex corner the box holds). Over
+  // the whole polygon, a star's inner corners, 1% of its radius from the
+  // centre, shared one or two cells, so every spike's ear scanned all of
+  // them: 2,000 corners spent the work limit and came out as a fan 118
+  // times the star's area (hostile pass).
   s.reflex.clear();
-  double x0 = q[0][0], x1 = x0, y0 = q[0][1], y1 = y0;
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
   for (int i = 0; i < n; ++i) {
-    x0 = std::min(x0, q[size_t(i)][0]), x1 = std::max(x1, q[size_t(i)][0]);
-    y0 = std::min(y0, q[size_t(i)][1]), y1 = std::max(y1, q[size_t(i)][1]);
-    if (!convex(i)) s.reflex.push_back(i);
+    if (convex(i)) continue;
+    const P2& p = q[size_t(i)];
+    if (s.reflex.empty()) x0 = x1 = p[0], y0 = y1 = p[1];
+    x0 = std::min(x0, p[0]), x1 = std::max(x1, p[0]);
+    y0 = std::min(y0, p[1]), y1 = std::max(y1, p[1]);
+    s.reflex.push_back(i);
   }
   const int g = std::max(1, int(std::sqrt(double(s.reflex.size()))));
   const double sx = x1 > x0 ? g / (x1 - x0) : 0, sy = y1 > y0 ? g / (y1 - y0) : 0;
