@@ -177,7 +177,9 @@ void generate_teapot(const std::string& inc, const std::string& out_path, int st
         if (std::hypot(q.x, q.z) < 1e-9) u = centre_u;  // on the axis: any angle
         while (u - centre_u > 0.5) u -= 1;
         while (u - centre_u < -0.5) u += 1;
-        uvs.push_back({u * kTurns, (q.y - ymin) / (ymax - ymin)});
+        // All patches at one height (ymax = ymin): v = 0, not 0/0 = NaN,
+        // which our own OBJ reader then refused (hostile pass).
+        uvs.push_back({u * kTurns, ymax > ymin ? (q.y - ymin) / (ymax - ymin) : 0.0});
         vid[j * (steps + 1) + i] = vertex(q);
         pos[j * (steps + 1) + i] = q;
       }

@@ -382,6 +382,17 @@ TEST(Hostile2Cli, TeapotIncIsCheckedAndItsWorkBounded) {
   const fs::path good = scratch("good.inc");
   std::ofstream(good) << patch;
   EXPECT_EQ(run_rayaudit("generate teapot " + good.string() + " -o " + out.string()).code, 0);
+  // A flat patch, all at one height: v was 0/0, written as -nan, which our
+  // own OBJ reader refused; now the output loads.
+  const fs::path flat = scratch("flat.inc");
+  std::ofstream(flat) << "bicubic_patch { type 1 flatness 0 u_steps 3 v_steps 3\n"
+                         "<0,0,0> <1,0,0> <2,0,0> <3,0,0>\n<0,1,0> <1,1,0> <2,1,0> <3,1,0>\n"
+                         "<0,2,0> <1,2,0> <2,2,0> <3,2,0>\n<0,3,0> <1,3,0> <2,3,0> <3,3,0>\n}\n";
+  auto r = run_rayaudit("generate teapot " + flat.string() + " -o " + out.string() + " --steps 2");
+  ASSERT_EQ(r.code, 0) << r.all;
+  EXPECT_EQ(ra::test::slurp(out).find("nan"), std::string::npos);
+  r = run_rayaudit("info " + out.string());
+  EXPECT_EQ(r.code, 0) << r.all;
 }
 
 // The streamed export on a full disk: one line, exit 2, the old file kept
