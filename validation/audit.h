@@ -165,6 +165,9 @@ struct Report {
 // Runs every subject over the chosen families (triangle subjects on triangle
 // families, sphere subjects on sphere families). Deterministic for any
 // thread count: cases depend only on (seed, family, sweep, chunk).
+// Throws std::invalid_argument for a family name that is not a family
+// (a typo judged nothing, and a check on nothing passed), a named family
+// no subject's kind grades, rays outside 1..1e10 or threads below 0.
 Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres,
            const Options& opt);
 

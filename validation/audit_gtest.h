@@ -32,7 +32,7 @@ struct CheckOptions {
   std::vector<std::string> families{};  // empty: the assertion's own default
   long long rays = 20000;
   std::uint64_t seed = 1;
-  int threads = 0;
+  int threads = 0;  // 0: all cores; the subject is called from that many threads at once
   std::optional<Shard> shard{};         // unset: every ray
 };
 
@@ -93,23 +93,39 @@ inline std::string shard_note(const CheckOptions& c) {
 }
 
 // Succeeds when no ray the exact answer sends through an edge pair, a vertex
-// fan or a closed mesh passes through the subject without a hit. The failure
-// message names every family@sweep that leaked, with counts and the seed.
+// fan or a closed mesh passes through the subject without a hit, and no hit
+// there has a t that is NaN, infinite or off by more than 1% (a renderer
+// drops such a hit, so the ray leaks all the same). The failure message
+// names every family@sweep that leaked, with counts and the seed. A run
+// that judged no group (every ray sharded away) fails too.
 inline ::testing::AssertionResult IsWatertight(const TriangleSubject& s, const CheckOptions& c = {}) {
   const Report r = run_check(s, c, {"edge", "vertex", "closed-mesh"});
-  std::ostringstream bad;
-  std::uint64_t leaks = 0, groups = 0;
+  std::ostringstream leaked, bad_t;
+  std::uint64_t leaks = 0, groups = 0, bad = 0;
   for (const Cell& cell : r.cells) {
     groups += cell.stats.groups;
-    if (cell.stats.leaks == 0) continue;
-    leaks += cell.stats.leaks;
-    bad << " " << cell.family << "@" << cell.sweep_label << ": " << cell.stats.leaks << "/"
-        << cell.stats.groups << ";";
+    if (cell.stats.leaks) {
+      leaks += cell.stats.leaks;
+      leaked << " " << cell.family << "@" << cell.sweep_label << ": " << cell.stats.leaks << "/"
+             << cell.stats.groups << ";";
+    }
+    const std::uint64_t t = cell.stats.wrong_t + cell.stats.nan_inf;
+    if (t) {
+      bad += t;
+      bad_t << " " << cell.family << "@" << cell.sweep_label << ": " << cell.stats.wrong_t << " off, "
+            << cell.stats.nan_inf << " NaN/inf;";
+    }
   }
-  if (leaks == 0)
+  if (groups == 0)
+    return ::testing::AssertionFailure() << s.name() << " was judged on no group (seed " << c.seed << shard_note(c)
+                                         << "): nothing shows it watertight";
+  if (leaks == 0 && bad == 0)
     return ::testing::AssertionSuccess() << s.name() << " did not leak on " << groups << " groups";
-  return ::testing::AssertionFailure() << s.name() << " leaked " << leaks << " of " << groups
-                                       << " groups (seed " << c.seed << shard_note(c) << "):" << bad.str();
+  auto failure = ::testing::AssertionFailure();
+  if (leaks) failure << s.name() << " leaked " << leaks << " of " << groups << " groups (seed " << c.seed << shard_note(c) << "):" << leaked.str();
+  else failure << s.name() << " did not leak on " << groups << " groups (seed " << c.seed << shard_note(c) << ")";
+  if (bad) failure << " and has " << bad << " hits with t NaN, infinite or off by more than 1%:" << bad_t.str();
+  return failure;
 }
 
 // Succeeds when the subject has no false hit, false miss, wrong t or NaN on

@@ -4,6 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 #include <optional>
 
 #include <rayaudit/audit.h>
@@ -61,6 +65,49 @@ TEST(ExampleUserIntersector, WrapperAroundRegistryWatertightPasses) {
         return k(r, a, b, c, /*cull=*/false);
       });
   EXPECT_WATERTIGHT(mine);
+}
+
+// The exact answer itself as an intersector (the oracle on the float
+// inputs, which double holds exactly): a hit wherever the closed triangle
+// is met, at the exact t. `mangle` spoils the t it returns.
+template <class Mangle>
+auto exact(Mangle mangle) {
+  return ra::audit::triangle_subject<float>(
+      "exact", [mangle](const ra::Rayf& r, const ra::Vec3f& a, const ra::Vec3f& b, const ra::Vec3f& c)
+                   -> std::optional<ra::TriangleHit<float>> {
+        const ra::oracle::Answer ans = ra::oracle::triangle(ra::Rayd(r), ra::Vec3d(a), ra::Vec3d(b), ra::Vec3d(c));
+        if (ans.verdict != ra::oracle::Verdict::hit && ans.verdict != ra::oracle::Verdict::boundary) return std::nullopt;
+        return ra::TriangleHit<float>{mangle(float(ans.t)), 0.25f, 0.25f};
+      });
+}
+
+// What the checks must refuse (hostile pass): hits whose t a renderer would
+// drop are leaks all the same; a family name that is not a family judged
+// nothing, and passed; and the exact answer is watertight, with no double
+// hit where it meets a shared edge or vertex exactly.
+TEST(ExampleUserIntersector, WatertightJudgesTheTOfHitsAndRefusesUnknownFamilies) {
+  const ra::audit::CheckOptions few{.rays = 3000};
+  const auto perfect = exact([](float t) { return t; });
+  EXPECT_TRUE(ra::audit::IsWatertight(perfect, few));
+  ra::audit::Options o;
+  o.families = {"edge", "vertex", "closed-mesh"};
+  o.rays = 3000;
+  const ra::audit::Report rep = ra::audit::run({perfect}, {}, o);
+  EXPECT_EQ(rep.total(0).double_hits, 0u) << rep.summary_table();
+  EXPECT_EQ(rep.total(0).leaks, 0u);
+  for (const auto& [name, spoil] : std::vector<std::pair<const char*, float (*)(float)>>{
+           {"NaN", [](float) { return std::numeric_limits<float>::quiet_NaN(); }},
+           {"infinite", [](float) { return std::numeric_limits<float>::infinity(); }},
+           {"behind the origin", [](float t) { return -t - 1; }},
+           {"always 1", [](float) { return 1.f; }}}) {
+    const ::testing::AssertionResult wt = ra::audit::IsWatertight(exact(spoil), few);
+    EXPECT_FALSE(wt) << name;
+    EXPECT_NE(std::string(wt.message()).find("off by more than 1%"), std::string::npos) << name << ": " << wt.message();
+  }
+  EXPECT_THROW(ra::audit::IsWatertight(perfect, {.families = {"edges"}}), std::invalid_argument);
+  EXPECT_THROW(ra::audit::HasNoWrongAnswers(perfect, {.families = {"huge"}}), std::invalid_argument)
+      << "a sphere family, and no sphere subject";
+  EXPECT_THROW(ra::audit::IsWatertight(perfect, {.rays = 0}), std::invalid_argument);
 }
 
 // A long audit spread over GoogleTest's shards: run with GTEST_TOTAL_SHARDS=N
