@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -304,7 +305,12 @@ void setup(CLI::App& app) {
   tp->add_option("inc", *inc, "teapot.inc (Debian povray-examples)")->required();
   tp->add_option("-o,--output", *out, "Output .obj")->required();
   tp->add_option("--steps", *steps, "Quads per patch side (default 8)")->check(CLI::Range(1, 256));
-  tp->callback([=] { generate_teapot(*inc, *out, *steps); });
+  tp->callback([=] {
+    // As convert: an OBJ named .png was written without a word (hostile pass).
+    const std::string ext = std::filesystem::path(*out).extension().string();
+    if (ext != ".obj" && ext != ".OBJ") throw ra::InputError(*out + ": the output must be a .obj file");
+    generate_teapot(*inc, *out, *steps);
+  });
   auto kind = std::make_shared<std::string>(), tout = std::make_shared<std::string>();
   auto size = std::make_shared<int>(256);
   auto* tx = cmd->add_subcommand("texture", "Write a test texture: uv-grid, heights or normals");

@@ -161,6 +161,13 @@ TEST_F(GoldenDataCli, ManifestEntriesAreReadStrictly) {
       {"\"spp\": 1", "\"spp\": 3", "/goldens/0/settings/spp: spp must be a square number"},
       {"\"accel\": \"bvh\"", "\"accel\": \"fast\"", "/goldens/0/settings/accel: unknown accel \"fast\""},
       {"\"spp\": 1", "\"spp\": 1, \"zz\": 0", "/goldens/0/settings/zz: unknown key"},
+      // Taken on trust before (hostile pass): a top-level key of no meaning,
+      // a scene that is another golden's, two goldens sharing one image.
+      {"\"goldens\":", "\"extra\": 1, \"goldens\":", "/extra: unknown key"},
+      {"\"scene\": \"scenes/a.json\"", "\"scene\": \"scenes/b.json\"",
+       "/goldens/0: scene \"scenes/b.json\" is not this golden's, scenes/a.json"},
+      {"\"image\": \"golden/b.png\"", "\"image\": \"golden/a.png\"",
+       "/goldens/1: image \"golden/a.png\" is golden \"a\"'s too"},
   };
   for (const Case& c : cases) {
     std::string m = manifest;

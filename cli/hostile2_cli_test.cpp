@@ -393,6 +393,12 @@ TEST(Hostile2Cli, TeapotIncIsCheckedAndItsWorkBounded) {
   EXPECT_EQ(ra::test::slurp(out).find("nan"), std::string::npos);
   r = run_rayaudit("info " + out.string());
   EXPECT_EQ(r.code, 0) << r.all;
+  // An OBJ named .png was written without a word; refused as convert refuses it.
+  const fs::path png = scratch("teapot.png");
+  r = run_rayaudit("generate teapot " + good.string() + " -o " + png.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, png.string() + ": the output must be a .obj file\n");
+  EXPECT_FALSE(fs::exists(png));
 }
 
 // The streamed export on a full disk: one line, exit 2, the old file kept

@@ -494,6 +494,8 @@ TEST(ReliabilityCli, ManifestOf20kEntriesIsReadInLinearTime) {
   for (int i = 0; i < 20000; ++i) {
     nlohmann::json e = m["goldens"][0];
     e["name"] = "t" + std::to_string(i);
+    e["scene"] = "scenes/t" + std::to_string(i) + ".json";  // each its own scene and image, as bless writes them
+    e["image"] = "golden/t" + std::to_string(i) + ".png";
     many["goldens"].push_back(e);
   }
   many["goldens"].back()["widht"] = 8;

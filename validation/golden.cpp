@@ -310,6 +310,13 @@ GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
   try {
     if (!j.is_object() || !j.contains("goldens") || !j.at("goldens").is_array())
       throw InputError(located(m.string(), lines.at("/goldens"), "expected an object with a \"goldens\" array"));
+    // What a reader would otherwise take on trust (hostile pass): a key
+    // of no meaning, an entry whose scene is another's, two entries
+    // sharing one image (each then checked against the other's render).
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (it.key() != "about" && it.key() != "goldens")
+        throw InputError(located(m.string(), lines.at("/" + it.key()), "/" + it.key() + ": unknown key"));
+    std::map<std::string, std::string> image_of;  // image -> the golden that has it
     const json& all = j.at("goldens");
     for (std::size_t i = 0; i < all.size(); ++i) {
       const std::string ptr = "/goldens/" + std::to_string(i);
@@ -325,6 +332,10 @@ GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
         throw InputError(located(m.string(), lines.at(sp), sp + ": " + why));
       }
       if (entries_.count(g.name)) throw InputError(at + ": golden \"" + g.name + "\" listed twice");
+      if (g.scene != "scenes/" + g.name + ".json")
+        throw InputError(at + ": scene \"" + g.scene + "\" is not this golden's, scenes/" + g.name + ".json");
+      if (const auto [it, fresh] = image_of.emplace(g.image, g.name); !fresh)
+        throw InputError(at + ": image \"" + g.image + "\" is golden \"" + it->second + "\"'s too");
       entries_[g.name] = g;
     }
   } catch (const json::exception& e) {
