@@ -41,9 +41,14 @@ fs::path small_audit(const fs::path& dir) {
   return a;
 }
 
+// `rayaudit report INPUTS -o DIR/rep`.
+ra::test::CliResult report(const fs::path& d, const std::string& inputs) {
+  return run_rayaudit("report " + inputs + " -o " + (d / "rep").string());
+}
+
 TEST(ReportCli, MissingAuditNamesTheFileExit2NothingWritten) {
   const fs::path d = fresh_dir("missing");
-  const auto r = run_rayaudit("report --audit " + (d / "nope.json").string() + " -o " + (d / "rep").string());
+  const auto r = report(d, "--audit " + (d / "nope.json").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find((d / "nope.json").string() + ": no such file"), std::string::npos) << r.err;
@@ -56,7 +61,7 @@ TEST(ReportCli, MalformedJsonNamesFileAndLineExit2NothingWritten) {
   const fs::path a = small_audit(d);
   const fs::path bad = d / "bench.json";
   std::ofstream(bad) << "{\n \"context\": {},\n \"benchmarks\": [\n  {\"name\": \"kernel/x\",}\n ]\n}\n";
-  const auto r = run_rayaudit("report --audit " + a.string() + " --bench " + bad.string() + " -o " + (d / "rep").string());
+  const auto r = report(d, "--audit " + a.string() + " --bench " + bad.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(bad.string() + ":4: malformed JSON"), std::string::npos) << r.err;
@@ -80,7 +85,7 @@ TEST(ReportCli, AcceptsGoogleBenchmarksNaN) {
      "ns_per_test": 7.7e-03}
   ]
 })";
-  const auto r = run_rayaudit("report --audit " + a.string() + " --bench " + b.string() + " -o " + (d / "rep").string());
+  const auto r = report(d, "--audit " + a.string() + " --bench " + b.string());
   ASSERT_EQ(r.code, 0) << r.all;
   const auto rep = nlohmann::json::parse(slurp(d / "rep" / "report.json"));
   bool seen = false;
@@ -107,7 +112,7 @@ TEST(ReportCli, NonFiniteOrNegativeFiguresAreRefused) {
                                    {"Infinity", "is NaN or infinite"},
                                    {"-3.0", "is negative"}}) {
     std::ofstream(b) << head << "\"ns_per_test\": " << value << "}]}";
-    const auto r = run_rayaudit("report --audit " + a.string() + " --bench " + b.string() + " -o " + (d / "rep").string());
+    const auto r = report(d, "--audit " + a.string() + " --bench " + b.string());
     EXPECT_EQ(r.code, 2) << value;
     EXPECT_EQ(r.err, b.string() + ": benchmarks[0]: 'ns_per_test' " + why + (why == "is negative" ? " (-3.0)\n" : "\n"))
         << r.err;
@@ -126,13 +131,13 @@ TEST(ReportCli, StagesWithAnyLineEnd) {
   for (const std::string eol : {"\r\n", "\r"}) {
     std::ofstream(st, std::ios::binary) << "render\t1.5" << eol << "audit\t2" << eol;
     fs::remove_all(d / "rep");
-    auto r = run_rayaudit("report --audit " + a.string() + " --stages " + st.string() + " -o " + (d / "rep").string());
+    auto r = report(d, "--audit " + a.string() + " --stages " + st.string());
     ASSERT_EQ(r.code, 0) << r.all;
     const auto rep = nlohmann::json::parse(slurp(d / "rep" / "report.json"));
     EXPECT_NE(rep.dump().find("\"audit\""), std::string::npos);
     std::ofstream(st, std::ios::binary) << "render\t1.5" << eol << "audit\tsoon" << eol;
     fs::remove_all(d / "rep");
-    r = run_rayaudit("report --audit " + a.string() + " --stages " + st.string() + " -o " + (d / "rep").string());
+    r = report(d, "--audit " + a.string() + " --stages " + st.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_EQ(r.err.rfind(st.string() + ":2: ", 0), 0u) << r.err;
   }
@@ -144,7 +149,7 @@ TEST(ReportCli, WrongShapeNamesTheKeyExit2) {
   const fs::path a = d / "audit.json";
   std::ofstream(a) << R"({"seed": 1, "rays_per_family": 10, "subjects": [{"name": "m/float"}], "cells": []})";
   fs::create_directories(d / "rep");  // an existing output directory stays untouched
-  const auto r = run_rayaudit("report --audit " + a.string() + " -o " + (d / "rep").string());
+  const auto r = report(d, "--audit " + a.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, a.string() + ": subjects[0]: missing 'method'\n");
   EXPECT_TRUE(fs::is_empty(d / "rep"));

@@ -128,8 +128,8 @@ std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {
     }
   }
   if (zero_faces)
-    warnings.push_back(set->name + ": " + std::to_string(zero_faces) + " triangle(s) use a zero-length vn (the " +
-                       std::to_string(first_zero + 1) + "th vn first); they take normals computed from the mesh, "
+    warnings.push_back(set->name + ": " + std::to_string(zero_faces) + " triangle(s) use a zero-length vn (first: vn #" +
+                       std::to_string(first_zero + 1) + " of the file); they take normals computed from the mesh, "
                        "as triangles without vn do");
   for (const auto& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   return set;
