@@ -33,6 +33,12 @@ struct RenderOptions {
   // Use AVX2 where the CPU has it (false: the baseline x86-64 SSE2 paths;
   // both give the same bits, which the Accel tests check).
   bool simd = true;
+  // The BVH's traversal also asks for the nodes and leaf blocks beside the
+  // ones it meets (accel/bvh.h, prefetch_node): by_size where a mesh's
+  // nodes and leaves exceed 32 MiB (a last-level cache), or always, or
+  // never. Speed only: the same hits and images (render_test).
+  enum class NeighbourPrefetch { by_size, always, never };
+  NeighbourPrefetch neighbour_prefetch = NeighbourPrefetch::by_size;
   // With simd: the one-mesh entry points compiled for AVX-512 where the CPU
   // has it (false: the AVX2 ones; the tests compare both).
   bool avx512 = true;

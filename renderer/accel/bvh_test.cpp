@@ -61,9 +61,15 @@ void compare(const Vec3d& at, double far, std::uint64_t seed, int* hits) {
     const Tracer none(scene, o);
     o.accel = Accel::bvh;
     const Tracer bvh(scene, o);  // AVX-512 or AVX2, as the CPU has
+    // The traversal that also asks for the nodes and leaves beside those it
+    // meets (by_size leaves it off on this small mesh): the same answers.
+    o.neighbour_prefetch = RenderOptions::NeighbourPrefetch::always;
+    const Tracer bvh_nb(scene, o);
+    o.neighbour_prefetch = RenderOptions::NeighbourPrefetch::by_size;
     o.avx512 = false;
     const Tracer bvh_avx2(scene, o);
     o.simd = false;
+    o.neighbour_prefetch = RenderOptions::NeighbourPrefetch::always;
     const Tracer bvh_sse2(scene, o);
     for (int i = 0; i < 4000; ++i) {
       Ray<double> r;
@@ -85,19 +91,22 @@ void compare(const Vec3d& at, double far, std::uint64_t seed, int* hits) {
       if (i % 13 == 8) r.d = r.d * 1e40;
       const auto a = none.intersect(r);
       if (i % 6 == 5 && a) r.tmax = a->t;  // a window ending at the hit
-      const auto b = bvh.intersect(r), c = bvh_sse2.intersect(r), e = bvh_avx2.intersect(r);
+      const auto b = bvh.intersect(r), c = bvh_sse2.intersect(r), e = bvh_avx2.intersect(r), f = bvh_nb.intersect(r);
       ASSERT_EQ(a.has_value(), b.has_value()) << i;
       ASSERT_EQ(a.has_value(), c.has_value()) << i;
       ASSERT_EQ(a.has_value(), e.has_value()) << i;
+      ASSERT_EQ(a.has_value(), f.has_value()) << i;
       if (a) {
         EXPECT_TRUE(a->t == b->t && a->prim == b->prim && a->b1 == b->b1 && a->b2 == b->b2) << i;
         EXPECT_TRUE(a->t == c->t && a->prim == c->prim && a->b1 == c->b1 && a->b2 == c->b2) << i;
         EXPECT_TRUE(a->t == e->t && a->prim == e->prim && a->b1 == e->b1 && a->b2 == e->b2) << i;
+        EXPECT_TRUE(a->t == f->t && a->prim == f->prim && a->b1 == f->b1 && a->b2 == f->b2) << i;
         ++*hits;
       }
       EXPECT_EQ(none.occluded(r), bvh.occluded(r)) << i;
       EXPECT_EQ(none.occluded(r), bvh_sse2.occluded(r)) << i;
       EXPECT_EQ(none.occluded(r), bvh_avx2.occluded(r)) << i;
+      EXPECT_EQ(none.occluded(r), bvh_nb.occluded(r)) << i;
     }
   }
 }
