@@ -36,7 +36,8 @@ struct RenderOptions {
   // The BVH's traversal also asks for the nodes and leaf blocks beside the
   // ones it meets (accel/bvh.h, prefetch_node): by_size where a mesh's
   // nodes and leaves exceed 32 MiB (a last-level cache), or always, or
-  // never. Speed only: the same hits and images (render_test).
+  // never. Speed only: the same hits and images (Bvh.SameHits* and
+  // ObjectBvh.SameBitsAsTheLoopOverObjects* force it on).
   enum class NeighbourPrefetch { by_size, always, never };
   NeighbourPrefetch neighbour_prefetch = NeighbourPrefetch::by_size;
   // With simd: the one-mesh entry points compiled for AVX-512 where the CPU

@@ -70,10 +70,9 @@ struct Bvh {
   std::vector<BvhNode> nodes;       // nodes[0] is the root (empty for an empty mesh)
   std::vector<std::uint32_t> order;  // slot -> triangle; leaf k's slots are 4k .. 4k + count - 1
   // A hint for the traversal, not part of the tree (build leaves it false):
-  // ask for the nodes either side in memory of every node asked for. See
-  // prefetch_node; the owner of the leaves sets it (render.cpp: when the
-  // nodes and leaves outgrow the last-level cache) and asks for leaves the
-  // same way.
+  // ask for the nodes and leaves either side in memory of every one asked
+  // for (prefetch_node says why). The owner of the leaves sets it
+  // (render.cpp: where the nodes and leaves outgrow the last-level cache).
   bool prefetch_neighbours = false;
 
   static bool is_leaf(std::uint32_t c) { return c != kEmpty && (c & kLeaf); }
