@@ -25,7 +25,7 @@
 #include "io/file_identity.h"
 #include "bench.h"
 #include "errors.h"
-#include "pov_runner.h"
+#include "pov/pov_runner.h"
 
 // ---- Heap accounting (peak bytes per triangle of the OBJ parsers, bytes of
 // our acceleration structures): every operator new counts its usable size.

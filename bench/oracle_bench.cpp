@@ -1,6 +1,6 @@
 // Group oracle/FAMILY/threads=T: throughput of the exact oracle
-// (validation/oracle.h) on every case family of the audit
-// (validation/families.h), in double: cases per second as a rate counter
+// (validation/exact/oracle.h) on every case family of the audit
+// (validation/exact/families.h), in double: cases per second as a rate counter
 // (issue 6 asks 2 million cases/s with 2 threads) and the share of cases
 // that needed exact arithmetic.
 #include <benchmark/benchmark.h>
@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "bench.h"
-#include "families.h"
-#include "oracle.h"
+#include "exact/families.h"
+#include "exact/oracle.h"
 
 namespace rb {
 namespace {

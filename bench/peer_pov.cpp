@@ -16,8 +16,8 @@
 #include "io/atomic_file.h"
 #include "bench.h"
 #include "errors.h"
-#include "pov_export.h"
-#include "pov_runner.h"
+#include "pov/pov_export.h"
+#include "pov/pov_runner.h"
 
 namespace rb {
 namespace {

@@ -1,5 +1,5 @@
 // `rayaudit audit`: grades the registry's methods against the exact oracle
-// (validation/audit.h) over generated families (whole or one --shard), user cases (--cases),
+// (validation/exact/audit.h) over generated families (whole or one --shard), user cases (--cases),
 // answers from any language (--grade), exports cases (--export-cases), merges shards (audit merge).
 #include <unistd.h>
 
@@ -17,12 +17,12 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
-#include "audit.h"
-#include "cases_csv.h"
+#include "exact/audit.h"
+#include "exact/cases_csv.h"
 #include "command.h"
 #include "errors.h"
 #include "io/file_identity.h"
-#include "grade.h"
+#include "exact/grade.h"
 #include "io/input_file.h"
 #include "io/json_input.h"
 #include "registry.h"

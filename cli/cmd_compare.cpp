@@ -1,12 +1,12 @@
 // `rayaudit compare SCENE`: renders the scene with our tracer and with
-// POV-Ray 3.7 at the same size, compares them (validation/image_compare.h)
+// POV-Ray 3.7 at the same size, compares them (validation/images/image_compare.h)
 // and judges the result against the scene's tolerance, scenes/pov/NAME.json
 // (default: identical at 8 bits). Exit 1 when a difference is not explained.
 //
 // `rayaudit compare --random N --seed S [--out DIR]` (issue 18) does the same
-// on N random scenes (validation/random_scene.h), explaining every differing
+// on N random scenes (validation/pov/random_scene.h), explaining every differing
 // pixel; a pixel no known cause explains is shrunk to a minimal scene
-// (validation/pov_shrink.h) written to DIR. Exit 1 if any remain.
+// (validation/pov/pov_shrink.h) written to DIR. Exit 1 if any remain.
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -17,14 +17,14 @@
 #include <tuple>
 #include "io/input_file.h"
 #include "memory_budget.h"
-#include "golden.h"
-#include "image_compare.h"
-#include "pov_explain.h"
-#include "pov_export.h"
-#include "pov_runner.h"
-#include "pov_shrink.h"
-#include "pov_tolerance.h"
-#include "random_scene.h"
+#include "images/golden.h"
+#include "images/image_compare.h"
+#include "pov/pov_explain.h"
+#include "pov/pov_export.h"
+#include "pov/pov_runner.h"
+#include "pov/pov_shrink.h"
+#include "pov/pov_tolerance.h"
+#include "pov/random_scene.h"
 #include "render.h"
 #include "scene/scene.h"
 #include "scene/scene_mesh.h"

@@ -1,5 +1,5 @@
 // `rayaudit crack-maps -o DIR`: closed meshes rendered far from the origin
-// with each triangle method in float, leaks painted red (validation/crack_maps.h).
+// with each triangle method in float, leaks painted red (validation/images/crack_maps.h).
 #include <unistd.h>
 
 #include <chrono>
@@ -11,7 +11,7 @@
 #include "io/atomic_file.h"
 #include "io/file_identity.h"
 #include "command.h"
-#include "crack_maps.h"
+#include "images/crack_maps.h"
 #include "errors.h"
 #include "scene/scene_mesh.h"
 

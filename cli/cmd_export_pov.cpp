@@ -1,13 +1,13 @@
 // `rayaudit export-pov SCENE -o FILE.pov`: the scene as POV-Ray 3.7 SDL that
-// renders the same image (validation/pov_export.h). Images are copied beside
+// renders the same image (validation/pov/pov_export.h). Images are copied beside
 // the .pov under generated names; nothing from the scene is written as SDL.
 #include <iostream>
 
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
-#include "pov_export.h"
-#include "pov_runner.h"
+#include "pov/pov_export.h"
+#include "pov/pov_runner.h"
 #include "scene/scene.h"
 
 namespace {

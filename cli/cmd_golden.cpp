@@ -1,5 +1,5 @@
 // `rayaudit golden check|bless [SCENE...]`: golden images of scenes/*.json
-// (validation/golden.h). check renders and compares (exit 1 on any
+// (validation/images/golden.h). check renders and compares (exit 1 on any
 // difference, writing a diff image); bless rewrites goldens, only when asked.
 #include <algorithm>
 #include <iostream>
@@ -10,7 +10,7 @@
 #include "io/file_identity.h"
 #include "command.h"
 #include "errors.h"
-#include "golden.h"
+#include "images/golden.h"
 
 namespace {
 

@@ -2,7 +2,7 @@
 // bytes. InputError is the expected rejection; anything else is a finding.
 #include <cstdint>
 
-#include "cases_csv.h"
+#include "exact/cases_csv.h"
 #include "errors.h"
 #include "file_input.h"
 

@@ -5,7 +5,7 @@
 
 #include "errors.h"
 #include "file_input.h"
-#include "pov_tolerance.h"
+#include "pov/pov_tolerance.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = fuzz_input_file(data, size, ".json");

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "scene/scene.h"
+#include <rayaudit/scene/scene.h>
 
 namespace ra {
 

@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pov_explain.h"
-#include "scene/scene.h"
+#include <rayaudit/scene/scene.h>
 
 namespace ra {
 

@@ -10,9 +10,9 @@
 #include <fstream>
 
 #include "errors.h"
-#include "image_compare.h"
+#include "images/image_compare.h"
 #include "pov_runner.h"
-#include "golden.h"
+#include "images/golden.h"
 #include "scene/scene.h"
 #include "scene/scene_mesh.h"
 

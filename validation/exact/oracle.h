@@ -3,7 +3,7 @@
 #pragma once
 #include <string_view>
 
-#include "ray.h"
+#include <rayaudit/ray.h>
 
 namespace ra::oracle {
 

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "image.h"
-#include "vec.h"
+#include <rayaudit/image.h>
+#include <rayaudit/vec.h>
 
 namespace ra::crack {
 

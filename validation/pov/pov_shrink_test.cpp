@@ -1,5 +1,5 @@
 // Tests of the random scenes and the shrinker of `rayaudit compare --random`
-// (validation/random_scene.h, validation/pov_shrink.h).
+// (validation/pov/random_scene.h, validation/pov/pov_shrink.h).
 #include "pov_shrink.h"
 
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 #include "pov_shrink.h"
 
 #include "errors.h"
-#include "image_compare.h"
+#include "images/image_compare.h"
 #include "pov_runner.h"
 #include "render.h"
 

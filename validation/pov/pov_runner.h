@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "image.h"
-#include "scene/scene.h"
+#include <rayaudit/image.h>
+#include <rayaudit/scene/scene.h>
 
 namespace ra {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "ray.h"
-#include "registry.h"
+#include <rayaudit/ray.h>
+#include <rayaudit/registry.h>
 
 namespace ra::audit {
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "image_compare.h"
-#include "io/atomic_file.h"
-#include "scene/scene.h"
+#include <rayaudit/io/atomic_file.h>
+#include <rayaudit/scene/scene.h>
 
 namespace ra {
 

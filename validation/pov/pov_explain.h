@@ -35,10 +35,10 @@
 #include <string>
 #include <vector>
 
-#include "image.h"
-#include "image_compare.h"
-#include "render.h"
-#include "scene/scene.h"
+#include <rayaudit/image.h>
+#include "../images/image_compare.h"
+#include <rayaudit/render.h>
+#include <rayaudit/scene/scene.h>
 
 namespace ra {
 

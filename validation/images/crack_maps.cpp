@@ -11,8 +11,8 @@
 
 #include "scene/camera.h"
 #include "errors.h"
-#include "families.h"
-#include "oracle.h"
+#include "exact/families.h"
+#include "exact/oracle.h"
 #include "registry.h"
 #include "render.h"
 #include "scene/scene_mesh.h"

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "image.h"
+#include <rayaudit/image.h>
 
 namespace ra {
 

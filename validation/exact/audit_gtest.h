@@ -1,4 +1,4 @@
-// GoogleTest assertions over the audit (validation/audit.h), so a user tests
+// GoogleTest assertions over the audit (validation/exact/audit.h), so a user tests
 // their own intersector against the exact oracle: EXPECT_WATERTIGHT(subject).
 //
 //   auto mine = ra::audit::triangle_subject<float>("mine", my_intersector);

@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "families.h"
-#include "hit.h"
+#include <rayaudit/hit.h>
 #include "oracle.h"
-#include "registry.h"
+#include <rayaudit/registry.h>
 
 namespace ra::audit {
 

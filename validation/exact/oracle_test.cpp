@@ -1,4 +1,4 @@
-// Tests of the exact oracle (validation/oracle.h) against hand-made cases
+// Tests of the exact oracle (validation/exact/oracle.h) against hand-made cases
 // whose answers follow from the geometry, and against a plain double solver where it is far from any boundary.
 #include "oracle.h"
 

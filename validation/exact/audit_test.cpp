@@ -1,4 +1,4 @@
-// Tests of the audit (validation/audit.h) whose expectations come from the
+// Tests of the audit (validation/exact/audit.h) whose expectations come from the
 // oracle and from geometry: watertight never leaks, moller-float does, codeproject takes the far root.
 #include "audit.h"
 

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "image_compare.h"
+#include "../images/image_compare.h"
 
 namespace ra {
 
