@@ -3,6 +3,11 @@
 // and judges the result against the scene's tolerance, scenes/pov/NAME.json
 // (default: identical at 8 bits). Exit 1 when a difference is not explained.
 //
+// `rayaudit compare SCENE --image THEIRS.png` judges another renderer's image
+// of the scene instead of ours, by the same tolerance, with the same diff;
+// --explain then names our models' causes where that image agrees with our
+// render (validation/images/their_image.h says which images are taken).
+//
 // `rayaudit compare --random N --seed S [--out DIR]` (issue 18) does the same
 // on N random scenes (validation/pov/random_scene.h), explaining every differing
 // pixel; a pixel no known cause explains is shrunk to a minimal scene
@@ -19,6 +24,7 @@
 #include "memory_budget.h"
 #include "images/golden.h"
 #include "images/image_compare.h"
+#include "images/their_image.h"
 #include "pov/pov_explain.h"
 #include "pov/pov_export.h"
 #include "pov/pov_runner.h"
@@ -35,7 +41,7 @@ namespace {
 constexpr int kSkipped = 77;
 
 struct Args {
-  std::string scene, json_out, diff_out, ours_out, pov_out, tolerance, out_dir;
+  std::string scene, json_out, diff_out, ours_out, pov_out, tolerance, out_dir, image;
   int bits = 8, width = 0, height = 0, threads = 0, random = 0;
   std::uint64_t seed = 1;
   bool keep = false, skip_inexpressible = false, explain = false, accept_explained = false;
@@ -65,7 +71,8 @@ void run_random(const Args& a) {
            {"--json", !a.json_out.empty()}, {"--diff", !a.diff_out.empty()}, {"--ours", !a.ours_out.empty()},
            {"--pov", !a.pov_out.empty()}, {"--tolerance", !a.tolerance.empty()}, {"--width", a.width > 0},
            {"--height", a.height > 0}, {"--bits", a.bits != 8}, {"--keep-pov-dir", a.keep},
-           {"--skip-inexpressible", a.skip_inexpressible}, {"--accept-explained", a.accept_explained}})
+           {"--skip-inexpressible", a.skip_inexpressible}, {"--accept-explained", a.accept_explained},
+           {"--image", !a.image.empty()}})
     if (set) throw ra::InputError(std::string(flag) + " cannot be used with --random (it compares at 8 bits and explains every pixel)");
   ra::find_povray();
   if (ra::random_scene_meshes().empty())
@@ -136,12 +143,42 @@ void run_random(const Args& a) {
                                              : "; minimal scenes in " + a.out_dir));
 }
 
+// --explain for another renderer's image: our models explain a difference
+// between our render and POV-Ray's, so they apply where the image equals
+// our render at that pixel (the renderer does as ours does, POV-Ray as
+// the model says); elsewhere the image differs from both, which no model
+// of ours explains.
+std::vector<ra::PixelExplanation> explain_their_differences(const ra::Scene& scene, const ra::Image& theirs,
+                                                            const ra::Image& pov, const ra::ImageComparison& c,
+                                                            const ra::RenderOptions& opt, int bits) {
+  const ra::Image mine = ra::render(scene, opt);
+  const ra::ImageComparison mc = ra::compare_images(mine, pov, bits);
+  const std::vector<ra::PixelExplanation> ours =
+      mc.differences.empty() ? std::vector<ra::PixelExplanation>{} : ra::explain_differences(scene, mine, pov, mc, opt);
+  std::map<std::pair<int, int>, std::string> cause;
+  for (const auto& e : ours) cause[{e.x, e.y}] = e.cause;
+  const ra::Image q_theirs = ra::quantized(theirs, bits), q_mine = ra::quantized(mine, bits);
+  std::vector<ra::PixelExplanation> out;
+  for (const auto& d : c.differences) {
+    ra::PixelExplanation e{d.x, d.y, d.levels, ""};
+    const float *t = q_theirs.at(d.x, d.y), *m = q_mine.at(d.x, d.y);
+    if (t[0] == m[0] && t[1] == m[1] && t[2] == m[2]) {
+      auto it = cause.find({d.x, d.y});
+      if (it != cause.end() && !it->second.empty()) e.cause = "as rayaudit's render, " + it->second;
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
 void run(const Args& a) {
   if (a.random_given) return run_random(a);
   if (a.scene.empty()) throw ra::InputError("compare needs a SCENE (or --random N)");
   if (!a.out_dir.empty()) throw ra::InputError("--out goes with --random");
   if (a.seed_given) throw ra::InputError("--seed goes with --random");
   if (a.bits != 8 && a.bits != 16) throw ra::InputError("--bits must be 8 or 16");
+  if (!a.image.empty() && !a.ours_out.empty())
+    throw ra::InputError("rayaudit compare: --ours cannot be used with --image (the image judged is " + a.image + ")");
   if (a.skip_inexpressible)
     if (const auto missing = ra::missing_cache_inputs(a.scene); !missing.empty()) {
       std::cout << "skipped: " << a.scene << " needs " << missing[0].string()
@@ -198,10 +235,23 @@ void run(const Args& a) {
                                                              (key[0] == 'w' ? " wide" : " high") +
                                                              " (give --width/--height, or a tolerance for this size)"));
 
+  // Another renderer's image, checked against the scene's render before
+  // either render is made.
+  ra::Image theirs;
+  if (!a.image.empty()) {
+    const std::string size = std::to_string(scene.width) + "x" + std::to_string(scene.height);
+    theirs = ra::read_their_image(a.image, {scene.width, scene.height, a.bits,
+                                            "the scene's render (" + size + ", --bits " + std::to_string(a.bits) + ")",
+                                            "render the scene at its own size, or give --width/--height"});
+  }
+
   ra::RenderOptions opt;
   opt.threads = a.threads;
   opt.progress = false;
-  const ra::Image ours = ra::render(scene, opt);
+  // `ours` is the image judged: our render, or theirs with --image (ours
+  // then rendered only for --explain, as `mine`).
+  const bool with_image = !a.image.empty();
+  const ra::Image ours = with_image ? theirs : ra::render(scene, opt);
   ra::PovRunOptions popt;
   popt.bits = a.bits;
   popt.keep_dir = a.keep;
@@ -209,12 +259,15 @@ void run(const Args& a) {
 
   const ra::ImageComparison c = ra::compare_images(ours, pov.image, a.bits);
   const ra::PovVerdict v = ra::judge(c, tol);
-  std::cout << "scene: " << a.scene << "\n" << ra::summary(c);
+  std::cout << "scene: " << a.scene << "\n";
+  if (with_image) std::cout << "image: " << a.image << " (against POV-Ray's render)\n";
+  std::cout << ra::summary(c);
   for (const auto& line : v.lines) std::cout << line << "\n";
   std::vector<ra::PixelExplanation> explained;
   if ((a.explain || a.accept_explained) && !c.differences.empty()) {
     std::cout << "likely causes (--explain):\n";
-    explained = ra::explain_differences(scene, ours, pov.image, c, opt);
+    explained = with_image ? explain_their_differences(scene, ours, pov.image, c, opt, a.bits)
+                           : ra::explain_differences(scene, ours, pov.image, c, opt);
     for (const auto& e : explained)
       std::cout << "  (" << e.x << ", " << e.y << ") " << e.levels << " levels: "
                 << (e.cause.empty() ? "none of the known causes" : e.cause) << "\n";
@@ -223,13 +276,19 @@ void run(const Args& a) {
   if (!pov.dir.empty()) std::cout << "POV-Ray's working directory: " << pov.dir.string() << "\n";
   if (!a.diff_out.empty()) {
     ra::write_image(a.diff_out, ra::difference_image(ours, pov.image, a.bits));
-    std::cout << "difference image: " << a.diff_out << "\n";
+    std::cout << "difference image: " << a.diff_out << "\n" << ra::difference_key_text();
   }
   if (!a.ours_out.empty()) ra::write_image(a.ours_out, ours, {a.bits, false});
   if (!a.pov_out.empty()) ra::write_image(a.pov_out, pov.image, {a.bits, false});
   if (!a.json_out.empty()) {
     nlohmann::json j = ra::to_json(c);
     j["scene"] = a.scene;
+    if (with_image) j["image"] = a.image;
+    j["against"] = "pov";
+    if (!a.diff_out.empty()) {
+      j["diff_image"] = a.diff_out;
+      j["diff_key"] = ra::difference_key_json();
+    }
     j["tolerance_file"] = tol.file.string();
     j["within_tolerance"] = v.pass;
     j["verdict"] = v.lines;
@@ -253,7 +312,8 @@ void run(const Args& a) {
     return;
   }
   if (!v.pass)
-    throw ra::CheckFailed(a.scene + ": our render differs from POV-Ray's beyond what " +
+    throw ra::CheckFailed(a.scene + ": " + (with_image ? a.image : std::string("our render")) +
+                          " differs from POV-Ray's beyond what " +
                           (tol.file.empty() ? std::string("the default (identical at 8 bits)") : tol.file.string()) +
                           " explains");
   std::cout << "within tolerance: yes\n";
@@ -280,6 +340,9 @@ void setup(CLI::App& app) {
                 "Pass when every differing pixel has a known cause (--explain), instead of judging by a tolerance "
                 "file (the corpus sweep)");
   cmd->add_option("--bits", args->bits, "Compare at 8 or 16 bits per channel (default 8)");
+  cmd->add_option("--image", args->image,
+                  "Judge this PNG (another renderer's image of SCENE: the scene's size, --bits, RGB, linear values) "
+                  "against POV-Ray's render instead of ours");
   cmd->add_option("--json", args->json_out, "Write the statistics as JSON");
   cmd->add_option("--diff", args->diff_out, "Write a false-colour difference image (.png)");
   cmd->add_option("--ours", args->ours_out, "Write our render (.png)");

@@ -1,6 +1,10 @@
 // `rayaudit golden check|bless [SCENE...]`: golden images of scenes/*.json
 // (validation/images/golden.h). check renders and compares (exit 1 on any
 // difference, writing a diff image); bless rewrites goldens, only when asked.
+// `golden check --image THEIRS.png SCENE` judges another renderer's image
+// of the scene against its golden instead of a render of ours. The project
+// is --root, or the one holding the current directory
+// (validation/images/golden_project.h).
 #include <algorithm>
 #include <iostream>
 #include <set>
@@ -11,13 +15,15 @@
 #include "command.h"
 #include "errors.h"
 #include "images/golden.h"
+#include "images/golden_project.h"
+#include "images/their_image.h"
 
 namespace {
 
 struct Args {
   std::vector<std::string> scenes;
-  std::string root = RAYAUDIT_SOURCE_DIR;
-  std::string diff_dir, json;
+  std::string root;  // empty: found from the current directory
+  std::string diff_dir, json, image;
   bool skip_unavailable = false;
 };
 
@@ -68,13 +74,51 @@ void check_creatable_dir(const std::filesystem::path& dir, const std::string& fl
   }
 }
 
+// How --root is found when not given: said by --help and by the error.
+constexpr const char* kRootRule =
+    "the nearest folder, from the current directory up, holding golden/manifest.json, or failing that one holding "
+    "scenes/";
+
 // --root must be a checkout: scenes/ beside golden/ (bless may create golden/).
-void check_root(const Args& a) {
+// Not given, it is the project holding the current directory (kRootRule),
+// never this program's own checkout (pasting a hint blessed there).
+void check_root(Args& a) {
+  if (a.root.empty()) {
+    std::error_code ec;
+    const auto cwd = std::filesystem::current_path(ec);
+    const auto found = ec ? std::nullopt : ra::find_golden_project(cwd);
+    if (!found)
+      throw ra::InputError("rayaudit golden: no project here: no folder from " + cwd.string() +
+                           " up holds golden/manifest.json or scenes/ (give --root)");
+    a.root = found->string();
+  }
   if (!std::filesystem::is_directory(std::filesystem::path(a.root) / "scenes"))
     throw ra::InputError(a.root + ": not a rayaudit repository (no scenes/ directory)");
 }
 
-void check(const Args& a) {
+// A diff folder in a golden folder, or a diff image on a golden, is refused
+// before any work: a --diff-dir naming another checkout's golden/ replaced
+// its golden image. Real paths, so a symlink to either is refused too.
+void check_diff_dir(const std::filesystem::path& diff_dir, const std::vector<std::string>& names,
+                    const ra::GoldenSet& set) {
+  if (const auto g = ra::golden_folder_of(diff_dir, set.root()))
+    throw ra::InputError(ra::located(diff_dir.string(), 0, "--diff-dir is in the golden folder " + g->string() +
+                                                               " (its images would be overwritten); give a folder "
+                                                               "outside every golden/"));
+  std::set<std::filesystem::path> goldens;
+  for (const auto& img : set.images()) goldens.insert(ra::real_path(img));
+  for (const auto& n : names)
+    for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {
+      if (const auto g = ra::golden_folder_of(out, set.root()))
+        throw ra::InputError(ra::located(out.string(), 0, "would be written in the golden folder " + g->string() +
+                                                              " (--diff-dir " + diff_dir.string() + ")"));
+      if (goldens.count(ra::real_path(out)))
+        throw ra::InputError(ra::located(out.string(), 0, "is a golden image (--diff-dir " + diff_dir.string() +
+                                                              " would overwrite it)"));
+    }
+}
+
+void check(Args a) {
   check_root(a);
   // Folders the diff images would need that are not there yet: removed
   // again if still empty when the command ends (a check that exits 2 on a
@@ -96,6 +140,8 @@ void check(const Args& a) {
   int failed = 0, skipped = 0;
   nlohmann::json rows = nlohmann::json::array();  // for --json (the report's golden section)
   const auto names = names_of(a.scenes, set);
+  if (!a.image.empty() && names.size() != 1)
+    throw ra::InputError("rayaudit golden check: --image judges one scene's image: name exactly one SCENE");
   if (names.empty())
     throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
                          ": no golden images to check");
@@ -119,6 +165,13 @@ void check(const Args& a) {
     for (const std::filesystem::path& in : set.inputs_of(n))
       if (std::filesystem::is_regular_file(in)) ra::note_input(in);
   check_creatable_dir(diff_dir, "--diff-dir");
+  check_diff_dir(diff_dir, names, set);
+  // The image to judge, checked against its golden before anything else.
+  const std::filesystem::path image(a.image);
+  if (!a.image.empty()) {
+    const auto ref = set.reference_of(names[0]);
+    ra::read_their_image(image, {ref.width, ref.height, ref.bits, ref.image, ""});
+  }
   // (Folders the diff images need that are not there yet: `made`, above.)
   for (const auto& n : names)
     for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {
@@ -136,6 +189,8 @@ void check(const Args& a) {
   for (const auto& n : names)
     for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {
       std::error_code ec;
+      if (!a.image.empty() && out.filename() != std::filesystem::path(n).filename().string() + ".diff.png")
+        continue;  // with --image, only the diff is written
       if (std::filesystem::is_directory(out.parent_path(), ec)) {
         outputs.add(out);
       } else if (!later.insert(std::filesystem::absolute(out).lexically_normal()).second) {
@@ -153,17 +208,32 @@ void check(const Args& a) {
       const std::string why = "needs " + missing[0].string() +
                               ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)";
       std::cout << "skip " << n << ": " << why << "\n";
-      rows.push_back({{"name", n}, {"status", "skip"}, {"message", why}});
+      rows.push_back({{"name", n}, {"status", "skip"}, {"message", why}, {"scene", "scenes/" + n + ".json"}});
       ++skipped;
       continue;
     }
-    const auto r = set.check(n, diff_dir, before_write);
+    const auto r = set.check(n, diff_dir, before_write, a.image.empty() ? nullptr : &image);
     std::cout << (r.pass ? "ok   " : "FAIL ") << r.message << "\n";
-    rows.push_back({{"name", n}, {"status", r.pass ? "ok" : "fail"}, {"message", r.message}});
+    // One row a scene: its status and message (the report's golden section)
+    // and, as compare --json has them, the comparison's fields.
+    nlohmann::json row = r.detail;
+    row["name"] = n;
+    row["status"] = r.pass ? "ok" : "fail";
+    row["message"] = r.message;
+    rows.push_back(row);
     failed += !r.pass;
   }
   // Written whatever the verdict: a failed check is what the report must show.
-  if (!a.json.empty()) ra::write_text_atomically(a.json, nlohmann::json{{"scenes", rows}}.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (!a.json.empty()) {
+    const nlohmann::json j = {{"root", std::filesystem::absolute(a.root).lexically_normal().string()},
+                              {"against", a.image.empty() ? "render" : "image"},
+                              {"checked", names.size()},
+                              {"failed", failed},
+                              {"skipped", skipped},
+                              {"diff_key", ra::difference_key_json()},
+                              {"scenes", rows}};
+    ra::write_text_atomically(a.json, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  }
   outputs.commit();  // the JSON and the diff images
   if (failed)
     throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
@@ -174,7 +244,7 @@ void check(const Args& a) {
 // Every scene is rendered before anything is renamed into golden/: a scene
 // that fails (exit 2) leaves every golden and the manifest as they were
 // (`bless A BAD` rewrote A's image, its manifest entry stale: issue 15).
-void bless(const Args& a) {
+void bless(Args a) {
   check_root(a);
   ra::OutputBatch outputs({});
   ra::GoldenSet set(a.root);
@@ -187,16 +257,28 @@ void bless(const Args& a) {
 void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand("golden", "Check scenes against their golden images, or bless new ones");
   cmd->require_subcommand(1);
-  auto add = [&](const char* name, const char* help, void (*fn)(const Args&)) {
+  cmd->footer(std::string("The project is --root, or else ") + kRootRule +
+              ". Hints name it with --root, so they work when pasted anywhere. Each golden is its scene at most "
+              "160 pixels on the long side unless its manifest entry sets \"max_side\", and must be identical "
+              "unless it sets \"tolerance\" {\"max_levels\": L, \"max_pixels\": P}.");
+  auto add = [&](const char* name, const char* help, void (*fn)(Args)) {
     auto args = std::make_shared<Args>();
     auto* sub = cmd->add_subcommand(name, help);
     sub->add_option("scenes", args->scenes, "Scene names or files (default: every scene in scenes/)");
-    sub->add_option("--root", args->root, "The repository (holding scenes/ and golden/)");
+    sub->add_option("--root", args->root,
+                    std::string("The project (holding scenes/ and golden/); default: ") + kRootRule);
     if (std::string(name) == "check") {
-      sub->add_option("--diff-dir", args->diff_dir, "Where to write diff images on failure (default /tmp/rayaudit-golden)");
+      sub->add_option("--diff-dir", args->diff_dir,
+                      "Where to write diff images on failure (default /tmp/rayaudit-golden); never inside a golden/ "
+                      "folder");
+      sub->add_option("--image", args->image,
+                      "Judge this PNG (another renderer's image of the one SCENE: the golden's size and bits, RGB, "
+                      "linear) against the golden instead of a render of ours");
       sub->add_flag("--skip-unavailable", args->skip_unavailable,
                     "Skip scenes whose ${cache} inputs are missing; exit 77 when all were skipped");
-      sub->add_option("--json", args->json, "Write each scene's status (ok, fail, skip) and message as JSON");
+      sub->add_option("--json", args->json,
+                      "Write each scene's status (ok, fail, skip), message and comparison (compare --json's fields, "
+                      "coordinates in scene pixels) as JSON");
     }
     sub->callback([args, fn] { fn(*args); });
   };

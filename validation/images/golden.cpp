@@ -7,6 +7,8 @@
 #include <set>
 #include <sstream>
 
+#include "golden_project.h"
+#include "their_image.h"
 #include "io/atomic_file.h"
 #include "errors.h"
 #include "io/input_file.h"
@@ -94,9 +96,14 @@ RenderOptions options_from(const json& s) {
 }
 
 json to_json(const GoldenEntry& e) {
-  return {{"name", e.name},     {"scene", e.scene},       {"image", e.image},   {"width", e.width},
-          {"height", e.height}, {"bits", e.bits},         {"settings", e.settings},
-          {"inputs_hash", e.inputs_hash},                 {"inputs", e.inputs}};
+  json j = {{"name", e.name},     {"scene", e.scene},       {"image", e.image},   {"width", e.width},
+            {"height", e.height}, {"bits", e.bits},         {"settings", e.settings},
+            {"inputs_hash", e.inputs_hash},                 {"inputs", e.inputs}};
+  // Written only when set, so the defaults' manifests stay as they were.
+  if (e.max_side != kGoldenMaxSize) j["max_side"] = e.max_side;
+  if (!e.tolerance.identical())
+    j["tolerance"] = {{"max_levels", e.tolerance.max_levels}, {"max_pixels", e.tolerance.max_pixels}};
+  return j;
 }
 
 // A JSON value as the file has it, for a message: numbers and booleans as
@@ -114,8 +121,8 @@ std::string shown(const json& v) {
 // `fail(path, what)` throws.
 template <class Fail>
 GoldenEntry entry_from(const json& j, const std::string& at, const Fail& fail) {
-  static const std::set<std::string> known = {"name",   "scene", "image",       "width",  "height",
-                                              "bits",   "settings", "inputs_hash", "inputs"};
+  static const std::set<std::string> known = {"name",     "scene",       "image",  "width",    "height",   "bits",
+                                              "settings", "inputs_hash", "inputs", "max_side", "tolerance"};
   for (auto it = j.begin(); it != j.end(); ++it)
     if (!known.count(it.key())) fail(at + "/" + it.key(), "unknown key");
   auto need = [&](const char* key) -> const json& {
@@ -144,6 +151,17 @@ GoldenEntry entry_from(const json& j, const std::string& at, const Fail& fail) {
     const json& b = j.at("bits");
     if (b != 8 && b != 16) fail(at + "/bits", "must be 8 or 16, got " + shown(b));
     e.bits = b.get<int>();
+  }
+  if (j.contains("max_side"))
+    e.max_side = integer(j.at("max_side"), at + "/max_side", 1, kMaxImageSide, " pixels");
+  if (j.contains("tolerance")) {
+    const json& t = j.at("tolerance");
+    if (!t.is_object()) fail(at + "/tolerance", "expected an object {\"max_levels\": L, \"max_pixels\": P}, got " + shown(t));
+    for (auto it = t.begin(); it != t.end(); ++it)
+      if (it.key() != "max_levels" && it.key() != "max_pixels") fail(at + "/tolerance/" + it.key(), "unknown key");
+    if (t.contains("max_levels")) e.tolerance.max_levels = integer(t.at("max_levels"), at + "/tolerance/max_levels", 0, 65535, " levels");
+    if (t.contains("max_pixels"))
+      e.tolerance.max_pixels = integer(t.at("max_pixels"), at + "/tolerance/max_pixels", 0, kMaxImageSide * kMaxImageSide / 4, " pixels");
   }
   e.settings = default_settings();
   if (j.contains("settings")) {
@@ -249,8 +267,8 @@ std::string changed_inputs(const std::map<std::string, std::string>& then,
   return out;
 }
 
-void golden_size(int w, int h, int& gw, int& gh) {
-  const double s = std::min(1.0, double(kGoldenMaxSize) / double(std::max(w, h)));
+void golden_size(int w, int h, int max_side, int& gw, int& gh) {
+  const double s = std::min(1.0, double(max_side) / double(std::max(w, h)));
   gw = std::max(1, int(std::lround(w * s)));
   gh = std::max(1, int(std::lround(h * s)));
 }
@@ -362,10 +380,15 @@ namespace {
 
 Image render_golden(const fs::path& scene_file, int w, int h, const json& settings, Scene* loaded = nullptr) {
   Scene s = load_scene(scene_file);
+  const int own_w = s.width, own_h = s.height;
   s.width = w;
   s.height = h;
   const Image img = render(s, options_from(settings));
-  if (loaded) *loaded = std::move(s);
+  if (loaded) {
+    *loaded = std::move(s);
+    loaded->width = own_w;  // the scene's own size, for coordinates in its pixels
+    loaded->height = own_h;
+  }
   return img;
 }
 
@@ -375,54 +398,176 @@ std::vector<fs::path> GoldenSet::diff_outputs(const std::string& name, const fs:
   return {diff_dir / (name + ".diff.png"), diff_dir / (name + ".png")};
 }
 
-GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff_dir,
-                                   const std::function<void(const fs::path&)>& before_write) const {
-  const fs::path scene_file = root_ / "scenes" / (name + ".json");
+std::string GoldenSet::bless_command(const std::string& name) const {
+  std::error_code ec;
+  // The name as typed when it is one plain word; the root always quoted.
+  const bool plain = !name.empty() && name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                             "0123456789._/+-") == std::string::npos;
+  return "rayaudit golden bless " + (plain ? name : shell_quoted(name)) + " --root " +
+         shell_quoted(fs::absolute(root_, ec).lexically_normal().string());
+}
+
+GoldenSet::Reference GoldenSet::reference_of(const std::string& name) const {
   auto it = entries_.find(name);
   if (it == entries_.end())
-    return {false, name + ": no golden image for scenes/" + name + ".json; render and record one with "
-                   "`rayaudit golden bless " + name + "` (then commit golden/)"};
+    throw InputError(located((root_ / "golden" / "manifest.json").string(), 0,
+                             "no golden \"" + name + "\" to judge an image against; record one with `" +
+                                 bless_command(name) + "`"));
+  return {it->second.width, it->second.height, it->second.bits, it->second.image};
+}
+
+std::vector<fs::path> GoldenSet::images() const {
+  std::vector<fs::path> out;
+  for (const auto& [n, e] : entries_) out.push_back(root_ / e.image);
+  return out;
+}
+
+namespace {
+
+// The scene pixel holding the centre of golden pixel g, the golden being n
+// pixels across a scene of N: the golden is the scene rendered at n / N of
+// its size, so its pixel centres fall at (g + 0.5) N / n scene pixels.
+int scene_pixel(int g, int n, int N) { return std::min(N - 1, int(std::floor((g + 0.5) * double(N) / double(n)))); }
+
+// The verdict of `c` under tolerance `t`: pass, and what it found.
+std::pair<bool, std::string> judge_golden(const ImageComparison& c, const GoldenTolerance& t) {
+  int worst = 0;
+  for (const auto& d : c.differences) worst = std::max(worst, d.levels);
+  const long n = long(c.differences.size());
+  const bool pass = n <= t.max_pixels && worst <= t.max_levels;
+  std::string says = std::to_string(n) + " pixels differ (at most " + std::to_string(t.max_pixels) +
+                     " allowed), by at most " + std::to_string(worst) + " levels (at most " +
+                     std::to_string(t.max_levels) + " allowed)";
+  return {pass, says};
+}
+
+}  // namespace
+
+GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff_dir,
+                                   const std::function<void(const fs::path&)>& before_write,
+                                   const fs::path* theirs) const {
+  const fs::path scene_file = root_ / "scenes" / (name + ".json");
+  Result r;
+  r.detail = {{"name", name}, {"scene", "scenes/" + name + ".json"}, {"root", fs::absolute(root_).string()}};
+  if (theirs) r.detail["image"] = theirs->string();
+  auto it = entries_.find(name);
+  if (it == entries_.end()) {
+    r.hint = bless_command(name) + " (then commit golden/)";
+    r.message = name + ": no golden image for scenes/" + name + ".json; render and record one with `" + r.hint + "`";
+    r.detail["hint"] = r.hint;
+    return r;
+  }
   const GoldenEntry& g = it->second;
-  if (!fs::exists(scene_file))
-    return {false, name + ": the scene " + g.scene + " is gone but its golden remains; `rayaudit golden bless " + name +
-                   "` removes it"};
+  r.detail["golden"] = g.image;
+  if (!fs::exists(scene_file)) {
+    r.hint = bless_command(name);
+    r.message = name + ": the scene " + g.scene + " is gone but its golden remains; `" + r.hint + "` removes it";
+    r.detail["hint"] = r.hint;
+    return r;
+  }
   // The golden first: its size, bounded by its file, is checked against the
   // manifest's before a render of the manifest's size (a width of 16384 with
   // an 8x8 golden rendered 3.3 GB first; issue 15).
   const Image golden = read_image(root_ / g.image);
-  if (golden.width != g.width || golden.height != g.height)
-    return {false, name + ": " + g.image + " is " + std::to_string(golden.width) + "x" +
-                   std::to_string(golden.height) + " but the manifest says " + std::to_string(g.width) + "x" +
-                   std::to_string(g.height) + "; re-bless it"};
+  if (golden.width != g.width || golden.height != g.height) {
+    r.hint = bless_command(name);
+    r.message = name + ": " + g.image + " is " + std::to_string(golden.width) + "x" + std::to_string(golden.height) +
+                " but the manifest says " + std::to_string(g.width) + "x" + std::to_string(g.height) +
+                "; re-bless it: `" + r.hint + "`";
+    r.detail["hint"] = r.hint;
+    return r;
+  }
   Scene scene;
-  const Image ours = render_golden(scene_file, g.width, g.height, g.settings, &scene);
+  Image candidate;
+  if (theirs) {
+    candidate = read_their_image(*theirs, {g.width, g.height, g.bits, g.image, ""});
+    scene = load_scene(scene_file);
+  } else {
+    candidate = render_golden(scene_file, g.width, g.height, g.settings, &scene);
+  }
+  const int sw = scene.width, sh = scene.height;  // the scene's own size (render_golden keeps it)
   const auto inputs = scene_inputs(scene, root_);
-  const std::string hash = combined_hash(inputs);
-  const std::string changed = hash == g.inputs_hash ? "" : changed_inputs(g.inputs, inputs);
-  const ImageComparison c = compare_images(ours, golden, g.bits);
+  const std::string changed = combined_hash(inputs) == g.inputs_hash ? "" : changed_inputs(g.inputs, inputs);
+  ImageComparison c = compare_images(candidate, golden, g.bits);
+  const auto [within, verdict] = judge_golden(c, g.tolerance);
+
+  // compare --json's fields, coordinates in scene pixels.
+  nlohmann::json& d = r.detail;
+  const nlohmann::json cj = to_json(c);
+  for (auto jt = cj.begin(); jt != cj.end(); ++jt) d[jt.key()] = jt.value();
+  d["scene_width"] = sw;
+  d["scene_height"] = sh;
+  auto sx = [&](int x) { return scene_pixel(x, g.width, sw); };
+  auto sy = [&](int y) { return scene_pixel(y, g.height, sh); };
+  d["max_error_pixel"] = {{"x", sx(c.max_x)}, {"y", sy(c.max_y)}, {"golden_x", c.max_x}, {"golden_y", c.max_y},
+                          {"channel", c.max_channel}};
+  nlohmann::json diffs = nlohmann::json::array();
+  for (const auto& p : c.differences)
+    diffs.push_back({{"x", sx(p.x)}, {"y", sy(p.y)}, {"golden_x", p.x}, {"golden_y", p.y}, {"levels", p.levels}});
+  d["differences"] = diffs;
+  d["tolerance"] = {{"max_levels", g.tolerance.max_levels}, {"max_pixels", g.tolerance.max_pixels}};
+  d["tolerance_file"] = (root_ / "golden" / "manifest.json").string();
+  d["within_tolerance"] = within;
+  d["verdict"] = nlohmann::json::array({verdict});
+  d["inputs_changed"] = changed;
+
   const std::string size = std::to_string(g.width) + "x" + std::to_string(g.height);
-  if (c.identical() && changed.empty()) return {true, name + ": identical to " + g.image + " (" + size + ")"};
-  std::string msg;
+  const std::string what = theirs ? theirs->string() : std::string("this render");
+  if (within && changed.empty()) {
+    r.pass = true;
+    r.message = name + ": " + (theirs ? what + " " : "") +
+                (c.identical() ? "identical to " + g.image + " (" + size + ")"
+                               : "within the tolerance of " + g.image + " (" + size + "): " + verdict);
+    return r;
+  }
   if (c.identical()) {
-    msg = name + ": the image is identical to " + g.image + ", but the inputs changed since it was blessed (" +
-          changed + "): the golden is stale; record them with `rayaudit golden bless " + name + "`";
-    return {false, msg};
+    r.hint = bless_command(name);
+    r.message = name + ": the image is identical to " + g.image + ", but the inputs changed since it was blessed (" +
+                changed + "): the golden is stale; record them with `" + r.hint + "`";
+    d["hint"] = r.hint;
+    return r;
   }
   std::error_code ec;
   const fs::path diff = diff_dir / (name + ".diff.png"), mine = diff_dir / (name + ".png");
   fs::create_directories(diff.parent_path(), ec);  // names may hold a folder: corpus/ladder-10-box
   if (before_write) before_write(diff);
-  write_image(diff, difference_image(ours, golden, g.bits));
-  if (before_write) before_write(mine);
-  write_image(mine, ours);
-  msg = name + ": differs from " + g.image + " (" + size + ")\n" + summary(c);
-  msg += "diff image: " + diff.string() + "\nthis render: " + mine.string() + "\n";
-  if (!changed.empty())
-    msg += "the inputs changed since the golden was blessed (" + changed +
-           "); if the new image is intended, `rayaudit golden bless " + name + "`";
-  else
-    msg += "the inputs are unchanged since the golden was blessed: the renderer's output changed";
-  return {false, msg};
+  write_image(diff, difference_image(candidate, golden, g.bits));
+  d["diff_image"] = diff.string();
+  d["diff_key"] = difference_key_json();
+  if (!theirs) {
+    if (before_write) before_write(mine);
+    write_image(mine, candidate);
+    d["render_image"] = mine.string();
+  }
+  // The summary's lines, the maximum's pixel in scene pixels.
+  ImageComparison shown = c;
+  shown.max_x = sx(c.max_x);
+  shown.max_y = sy(c.max_y);
+  r.message = name + ": " + (theirs ? what + " " : "") + (within ? "matches " : "differs from ") + g.image + " (" +
+              size + (g.width == sw && g.height == sh ? "" : ", the scene's " + std::to_string(sw) + "x" +
+                                                              std::to_string(sh) + " scaled") +
+              "): " + verdict + "\n" + summary(shown);
+  r.message += "coordinates are scene pixels (of " + std::to_string(sw) + "x" + std::to_string(sh) + ")";
+  if (g.width != sw || g.height != sh) r.message += "; the golden and diff images are " + size;
+  r.message += "\nfirst differences:";
+  for (std::size_t i = 0; i < c.differences.size() && i < 8; ++i)
+    r.message += " (" + std::to_string(sx(c.differences[i].x)) + ", " + std::to_string(sy(c.differences[i].y)) + ") " +
+                 std::to_string(c.differences[i].levels) + (c.differences[i].levels == 1 ? " level" : " levels") +
+                 (i + 1 < c.differences.size() && i < 7 ? ";" : "");
+  if (c.differences.size() > 8) r.message += " ...";
+  r.message += "\ndiff image: " + diff.string() + "\n" + difference_key_text();
+  if (!theirs) r.message += "this render: " + mine.string() + "\n";
+  if (!changed.empty()) {
+    r.hint = bless_command(name);
+    r.message += "the inputs changed since the golden was blessed (" + changed + "); if the new image is intended, `" +
+                 r.hint + "`";
+    d["hint"] = r.hint;
+  } else if (theirs) {
+    r.message += "the scene's inputs are unchanged since the golden was blessed: the difference is the image's";
+  } else {
+    r.message += "the inputs are unchanged since the golden was blessed: the renderer's output changed";
+  }
+  return r;
 }
 
 std::string GoldenSet::bless(const std::string& name, OutputBatch* batch) {
@@ -440,8 +585,13 @@ std::string GoldenSet::bless(const std::string& name, OutputBatch* batch) {
   g.scene = "scenes/" + name + ".json";
   g.image = "golden/" + name + ".png";
   g.settings = default_settings();
+  // A size and tolerance set in the manifest for this scene stay.
+  if (auto was = entries_.find(name); was != entries_.end()) {
+    g.max_side = was->second.max_side;
+    g.tolerance = was->second.tolerance;
+  }
   Scene scene = load_scene(scene_file);
-  golden_size(scene.width, scene.height, g.width, g.height);
+  golden_size(scene.width, scene.height, g.max_side, g.width, g.height);
   const Image img = render_golden(scene_file, g.width, g.height, g.settings, &scene);
   g.inputs = scene_inputs(scene, root_);
   g.inputs_hash = combined_hash(g.inputs);
@@ -488,7 +638,10 @@ void GoldenSet::save(OutputBatch* batch) const {
   json all = json::array();
   for (const auto& [n, e] : entries_) all.push_back(to_json(e));
   json j = {{"about", "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
-                      "`rayaudit golden check` (ctest label golden), rewritten only by `rayaudit golden bless`."},
+                      "`rayaudit golden check` (ctest label golden), rewritten only by `rayaudit golden bless`. "
+                      "Each is its scene rendered at most \"max_side\" pixels on the long side (default 160) and "
+                      "must match within \"tolerance\" {\"max_levels\": L, \"max_pixels\": P} (default "
+                      "identical); both may be set per golden."},
             {"goldens", all}};
   std::error_code ec;
   fs::create_directories(root_ / "golden", ec);

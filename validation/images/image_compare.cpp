@@ -92,6 +92,35 @@ Image difference_image(const Image& ours, const Image& theirs, int bits) {
   return out;
 }
 
+const std::vector<DifferenceBand>& difference_key() {
+  // The bands difference_image() draws, in the same order as its tests.
+  static const std::vector<DifferenceBand> key = {
+      {"grey", 0, 0, "identical (the first image dimmed to a quarter)"},
+      {"blue", 1, 1, "1 level"},
+      {"green", 2, 4, "2 to 4 levels"},
+      {"yellow", 5, 16, "5 to 16 levels"},
+      {"red", 17, -1, "more than 16 levels"},
+  };
+  return key;
+}
+
+std::string difference_key_text() {
+  std::string out = "diff colours (largest channel difference, 8-bit levels; brighter = larger):";
+  for (const auto& b : difference_key()) out += " " + b.colour + " " + b.meaning + ";";
+  out.back() = '\n';
+  return out;
+}
+
+nlohmann::json difference_key_json() {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& b : difference_key())
+    out.push_back({{"colour", b.colour},
+                   {"min_levels", b.min_levels},
+                   {"max_levels", b.max_levels < 0 ? nlohmann::json(nullptr) : nlohmann::json(b.max_levels)},
+                   {"meaning", b.meaning}});
+  return out;
+}
+
 nlohmann::json to_json(const ImageComparison& c) {
   nlohmann::json j;
   j["width"] = c.width;

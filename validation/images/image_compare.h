@@ -37,6 +37,19 @@ ImageComparison compare_images(const Image& ours, const Image& theirs, int bits)
 // yellow (5..16) or red (more), brighter for larger errors.
 Image difference_image(const Image& ours, const Image& theirs, int bits);
 
+// The colours difference_image() uses, for a reader of the image: each band
+// of the largest channel difference, in 8-bit levels (at 16 bits, a
+// difference counts as levels * 255 / 65535), with its colour.
+struct DifferenceBand {
+  std::string colour;  // "grey", "blue", ...
+  int min_levels = 0, max_levels = 0;  // 8-bit levels; max -1: no bound
+  std::string meaning;
+};
+const std::vector<DifferenceBand>& difference_key();
+// The key as lines ("  grey: ...") after a heading, and as a JSON array.
+std::string difference_key_text();
+nlohmann::json difference_key_json();
+
 nlohmann::json to_json(const ImageComparison& c);
 // Several lines: mean, RMS, PSNR, max error and where, over 1/255, over 4/255.
 std::string summary(const ImageComparison& c);
