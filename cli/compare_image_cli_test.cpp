@@ -97,4 +97,31 @@ TEST_F(CompareImage, BadImagesAreRefusedNamingTheFileBeforeAnyRender) {
   EXPECT_TRUE(one_line(over.err)) << over.err;
 }
 
+// --explain on another renderer's image: where it equals our render, our
+// models name the cause of its difference from POV-Ray's (the tetrahedron's
+// one pixel, scenes/pov/doc002-tetrahedron.json); a pixel it changed on its
+// own has none.
+TEST(CompareImageExplain, OurModelsApplyWhereTheImageEqualsOurRender) {
+  const fs::path dir = fs::temp_directory_path() / ("rayaudit-compare-image-explain-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/doc002-tetrahedron.json";
+  auto r = run_rayaudit("compare " + scene + " --ours " + (dir / "ours.png").string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  ra::Image img = ra::read_image(dir / "ours.png");
+  img.at(5, 5)[0] = img.at(5, 5)[0] > 0.5f ? 0.0f : 1.0f;
+  ra::write_image(dir / "theirs.png", img);
+  r = run_rayaudit("compare " + scene + " --image " + (dir / "theirs.png").string() + " --explain --json " +
+                   (dir / "c.json").string());
+  EXPECT_EQ(r.code, 1) << r.all;
+  EXPECT_NE(r.out.find("(166, 199) 1 levels: as rayaudit's render, equal normals"), std::string::npos) << r.out;
+  const auto at = r.out.find("  (5, 5) ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_NE(r.out.substr(at, r.out.find('\n', at) - at).find("levels: none of the known causes"), std::string::npos)
+      << r.out;
+  const auto j = nlohmann::json::parse(slurp(dir / "c.json"));
+  ASSERT_EQ(j["explanations"].size(), 2u);
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -37,7 +37,9 @@ fs::path real_path(const fs::path& p) {
         const fs::path target = fs::read_symlink(next, ec);
         fs::path tail;
         for (auto jt = std::next(it); jt != rel.end(); ++jt) tail /= *jt;
-        rest = ((target.is_absolute() ? target : done / target) / tail).lexically_normal();
+        rest = (target.is_absolute() ? target : done / target).lexically_normal();
+        if (!tail.empty()) rest = (rest / tail).lexically_normal();  // "a" / "" would be "a/"
+        if (rest.has_relative_path() && rest.filename().empty()) rest = rest.parent_path();
         relinked = true;
         break;
       }
