@@ -49,7 +49,8 @@ class GoldenProject : public ::testing::Test {
     fs::create_directories(root / "scenes");
     fs::copy_file(kSphereOnPlane, root / "scenes" / "s.json");
     std::ofstream(root / "scenes" / "t.json")
-        << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}, "material": {"color": 0.5}}]})" << "\n";
+        << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}, "material": {"color": 0.5}}]})"
+        << "\n";
     const auto r = run_in(root / "scenes", "golden bless");
     ASSERT_EQ(r.code, 0) << r.all;
   }
@@ -77,7 +78,8 @@ TEST_F(GoldenProject, BlessAndCheckFromInsideTheProjectUseItsGoldens) {
   // A scene only this program's checkout has is not found here.
   const auto other = run_in(root, "golden check doc000-pyramid");
   EXPECT_EQ(other.code, 2) << other.all;
-  EXPECT_EQ(other.err, (root / "scenes" / "doc000-pyramid.json").string() + ": no such file, and no golden of that name\n");
+  EXPECT_EQ(other.err,
+            (root / "scenes" / "doc000-pyramid.json").string() + ": no such file, and no golden of that name\n");
 }
 
 TEST_F(GoldenProject, OutsideAnyProjectCheckSaysHowTheProjectIsFound) {
@@ -97,14 +99,16 @@ TEST_F(GoldenProject, OutsideAnyProjectCheckSaysHowTheProjectIsFound) {
 // it blesses this project's golden, and the check then passes.
 TEST_F(GoldenProject, FailureHintNamesTheRootAndWorksPastedElsewhere) {
   std::ofstream(root / "scenes" / "t.json")
-      << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}, "material": {"color": 0.25}}]})" << "\n";
+      << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}, "material": {"color": 0.25}}]})"
+      << "\n";
   auto r = run_in(root, "golden check t --diff-dir '" + (base / "d").string() + "'");
   EXPECT_EQ(r.code, 1) << r.all;
   const std::string hint = "rayaudit golden bless t --root '" + root.string() + "'";
   const auto at = r.out.find(hint);
   ASSERT_NE(at, std::string::npos) << r.out;
   fs::create_directories(base / "elsewhere");
-  const auto pasted = run_rayaudit(hint.substr(std::string("rayaudit ").size()), "cd '" + (base / "elsewhere").string() + "' &&");
+  const auto pasted =
+      run_rayaudit(hint.substr(std::string("rayaudit ").size()), "cd '" + (base / "elsewhere").string() + "' &&");
   EXPECT_EQ(pasted.code, 0) << pasted.all;
   EXPECT_EQ(run_in(root, "golden check t --diff-dir '" + (base / "d").string() + "'").code, 0);
 }
@@ -156,7 +160,8 @@ TEST_F(GoldenProject, ManifestSetsSizeAndToleranceAndFailuresSpeakScenePixels) {
   EXPECT_NE(r.out.find("at pixel (21, 41)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("first differences: (21, 41) 3 levels"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("coordinates are scene pixels (of 320x240); the golden and diff images are 160x120"),
-            std::string::npos) << r.out;
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("diff colours"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("green 2 to 4 levels"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(base / "d" / "s.diff.png"));
@@ -169,7 +174,8 @@ TEST_F(GoldenProject, ManifestSetsSizeAndToleranceAndFailuresSpeakScenePixels) {
   EXPECT_EQ(s["scene_width"], 320);
   EXPECT_EQ(s["differing"], 1);
   ASSERT_EQ(s["differences"].size(), 1u);
-  EXPECT_EQ(s["differences"][0], (nlohmann::json{{"x", 21}, {"y", 41}, {"golden_x", 10}, {"golden_y", 20}, {"levels", 3}}));
+  EXPECT_EQ(s["differences"][0],
+            (nlohmann::json{{"x", 21}, {"y", 41}, {"golden_x", 10}, {"golden_y", 20}, {"levels", 3}}));
   EXPECT_EQ(s["max_error_pixel"]["x"], 21);
   EXPECT_EQ(s["diff_key"][2]["colour"], "green");
   EXPECT_EQ(j["diff_key"].size(), 5u);
@@ -236,11 +242,10 @@ TEST_F(GoldenProject, BadImagesAreRefusedNamingTheFile) {
   struct Case {
     std::string file, says;
   };
-  for (const Case& c : {Case{"small.png", "is 80x60, but golden/s.png is 160x120"},
-                        Case{"deep.png", "has 16 bits a channel; golden/s.png has 8"},
-                        Case{"srgb.png", "is tagged as "},
-                        Case{"text.png", "not a PNG file"},
-                        Case{"missing.png", "no such file"}}) {
+  for (const Case& c :
+       {Case{"small.png", "is 80x60, but golden/s.png is 160x120"},
+        Case{"deep.png", "has 16 bits a channel; golden/s.png has 8"}, Case{"srgb.png", "is tagged as "},
+        Case{"text.png", "not a PNG file"}, Case{"missing.png", "no such file"}}) {
     const auto r = run_in(root, "golden check s --image '" + (base / c.file).string() + "' --diff-dir '" +
                                     (base / "d").string() + "' --json '" + (base / "g.json").string() + "'");
     EXPECT_EQ(r.code, 2) << c.file << ": " << r.all;

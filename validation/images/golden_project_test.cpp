@@ -45,8 +45,8 @@ TEST_F(GoldenProjectRules, NearestManifestFirstThenNearestScenesFolder) {
 
 TEST_F(GoldenProjectRules, RealPathResolvesEveryLinkAlsoDangling) {
   fs::create_directories(d / "real" / "golden");
-  fs::create_directory_symlink("real/golden", d / "rel");             // relative
-  fs::create_directory_symlink(d / "rel", d / "chain");                // a link to a link
+  fs::create_directory_symlink("real/golden", d / "rel");  // relative
+  fs::create_directory_symlink(d / "rel", d / "chain");    // a link to a link
   fs::create_directory_symlink(d / "real" / "golden" / "none", d / "dangling");
   fs::create_symlink("loop", d / "loop");
   EXPECT_EQ(ra::real_path(d / "rel" / "a" / "b.png"), d / "real" / "golden" / "a" / "b.png");

@@ -74,19 +74,27 @@ Image read_their_image(const fs::path& file, const ImageReference& want) {
                      size + (want.remedy.empty() ? "" : " (" + want.remedy + ")"));
   switch (h.colour_type) {
     case 0:
-    case 4: refuse(file, "is greyscale; " + want.what + " is RGB");
-    case 3: refuse(file, "is a palette image; " + want.what + " is RGB (write 8 or 16 bits a channel)");
+    case 4:
+      refuse(file, "is greyscale; " + want.what + " is RGB");
+    case 3:
+      refuse(file, "is a palette image; " + want.what + " is RGB (write 8 or 16 bits a channel)");
     case 2:
-    case 6: break;
-    default: refuse(file, "PNG colour type " + std::to_string(h.colour_type) + " is not RGB");
+    case 6:
+      break;
+    default:
+      refuse(file, "PNG colour type " + std::to_string(h.colour_type) + " is not RGB");
   }
   if (h.bit_depth != want.bits)
     refuse(file, "has " + std::to_string(h.bit_depth) + " bits a channel; " + want.what + " has " +
-                     std::to_string(want.bits) + (want.bits == 8 ? " (compare takes --bits 16 for 16-bit images)" : ""));
+                     std::to_string(want.bits) +
+                     (want.bits == 8 ? " (compare takes --bits 16 for 16-bit images)" : ""));
   if (h.srgb || h.iccp || (h.gamma >= 0 && h.gamma != 100000))
     refuse(file, std::string("is tagged as ") +
-                     (h.srgb ? "sRGB" : h.iccp ? "an ICC profile" : "gamma " + std::to_string(h.gamma / 1e5).substr(0, 7)) +
-                     "; " + want.what + " holds linear values (gAMA 1.0, or untagged): write the renderer's values "
+                     (h.srgb   ? "sRGB"
+                      : h.iccp ? "an ICC profile"
+                               : "gamma " + std::to_string(h.gamma / 1e5).substr(0, 7)) +
+                     "; " + want.what +
+                     " holds linear values (gAMA 1.0, or untagged): write the renderer's values "
                      "without a gamma curve");
   int w = 0, hh = 0, channels = 0;
   const std::vector<float> px = read_pixels(file, "image", w, hh, channels);
@@ -94,8 +102,8 @@ Image read_their_image(const fs::path& file, const ImageReference& want) {
   Image img(w, hh);
   for (std::size_t i = 0, n = std::size_t(w) * hh; i < n; ++i) {
     if (channels == 4 && px[i * 4 + 3] < 1.0f)
-      refuse(file, "pixel (" + std::to_string(i % w) + ", " + std::to_string(i / w) + ") is not opaque; " +
-                       want.what + " has no alpha (write opaque pixels, or RGB)");
+      refuse(file, "pixel (" + std::to_string(i % w) + ", " + std::to_string(i / w) + ") is not opaque; " + want.what +
+                       " has no alpha (write opaque pixels, or RGB)");
     for (int c = 0; c < 3; ++c) img.rgb[i * 3 + c] = px[i * channels + c];
   }
   note_input(file);

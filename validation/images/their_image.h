@@ -19,9 +19,9 @@ namespace ra {
 
 struct ImageReference {
   int width = 0, height = 0;
-  int bits = 8;       // 8 or 16
-  std::string what;   // names the reference in messages: "the scene's render", "golden/a.png"
-  std::string remedy; // said after a size mismatch: how to get an image of the right size
+  int bits = 8;        // 8 or 16
+  std::string what;    // names the reference in messages: "the scene's render", "golden/a.png"
+  std::string remedy;  // said after a size mismatch: how to get an image of the right size
 };
 
 // The PNG's pixels as linear RGB (values v / 255 or v / 65535), after the
