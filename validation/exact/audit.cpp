@@ -591,8 +591,8 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
   Report rep;
   rep.seed = opt.seed;
   rep.rays = opt.rays;
-  for (const auto& s : tris) rep.subjects.push_back(s.name()), rep.kinds.push_back("triangle");
-  for (const auto& s : spheres) rep.subjects.push_back(s.name()), rep.kinds.push_back("sphere");
+  for (const auto& s : tris) rep.subjects.push_back(s.name()), rep.kinds.push_back("triangle"), rep.peers.push_back(s.peer);
+  for (const auto& s : spheres) rep.subjects.push_back(s.name()), rep.kinds.push_back("sphere"), rep.peers.emplace_back();
 
   std::vector<const Family*> fams;
   for (const Family& f : families()) {
@@ -732,10 +732,12 @@ nlohmann::json Report::to_json() const {
                     {"method", subjects[i].substr(0, slash)},
                     {"precision", subjects[i].substr(slash + 1)},
                     {"kind", kinds[i]},
+                    {"peer", peer(i) != nullptr},
                     {"totals", total(i).to_json()},
                     {"worst", w ? nlohmann::json{{"family", w->family}, {"sweep", w->sweep_label},
                                                  {"badness", w->stats.badness()}}
                                 : nlohmann::json(nullptr)}});
+    if (const PeerInfo* p = peer(i)) subs.back()["what"] = p->what, subs.back()["speed_source"] = p->speed_source;
   }
   for (const Cell& c : cells) {
     const Family* f = find_family(c.family);
@@ -784,6 +786,9 @@ Report Report::from_json(const nlohmann::json& j) {
       throw std::runtime_error("a subject without a name or kind");
     r.subjects.push_back(s["name"].get<std::string>());
     r.kinds.push_back(s["kind"].get<std::string>());
+    if (s.contains("peer") && !s["peer"].is_boolean()) throw std::runtime_error("a subject's 'peer' is not true/false");
+    r.peers.emplace_back();
+    if (s.value("peer", false)) r.peers.back() = PeerInfo{s.value("what", ""), s.value("speed_source", "")};
   }
   for (const auto& c : need(j, "cells")) {
     if (!need(c, "subject").is_string() || !need(c, "family").is_string() || !need(c, "sweep").is_string())
@@ -848,6 +853,9 @@ std::string Report::summary_table() const {
       "LEAKS = edge/vertex/mesh rays the exact answer hits and the method misses entirely; "
       "DOUBLE = more hits than exact crossings; SELF% = spawned secondary rays re-hitting their triangle;\n"
       "hitting or missing a boundary/coplanar/degenerate case is never counted wrong (its counts are in the JSON).\n";
+  for (std::size_t i = 0; i < subjects.size(); ++i)
+    if (const PeerInfo* p = peer(i))
+      out += "peer " + subjects[i] + ": " + p->what + "; speed figure: " + p->speed_source + "\n";
   return out;
 }
 
@@ -866,7 +874,7 @@ std::string Report::to_csv() const {
   std::ostringstream os;
   os << "method,precision,family,sweep,tests,wrong,true_hits,false_hits,true_misses,false_misses,wrong_t,boundary_hits,"
         "boundary_misses,coplanar_hits,coplanar_misses,degenerate_hits,degenerate_misses,nan_inf,"
-        "groups,leaks,double_hits,spawned,self_hits,t_ulps_median,t_ulps_max,t_rel_median,t_rel_max\n";
+        "groups,leaks,double_hits,spawned,self_hits,t_ulps_median,t_ulps_max,t_rel_median,t_rel_max,peer\n";
   for (const Cell& c : cells) {
     const Stats& s = c.stats;
     const std::string& n = subjects[c.subject];
@@ -879,7 +887,7 @@ std::string Report::to_csv() const {
        << ',' << s.coplanar_misses << ',' << s.degenerate_hits << ',' << s.degenerate_misses << ','
        << s.nan_inf << ',' << s.groups << ',' << s.leaks << ',' << s.double_hits << ',' << s.spawned
        << ',' << s.self_hits << ',' << s.median_ulps() << ',' << s.max_ulps << ','
-       << fmt("%.6g", s.median_rel()) << ',' << fmt("%.6g", s.max_rel) << '\n';
+       << fmt("%.6g", s.median_rel()) << ',' << fmt("%.6g", s.max_rel) << ',' << (peer(c.subject) ? 1 : 0) << '\n';
   }
   return os.str();
 }

@@ -30,12 +30,21 @@ using TriangleFn = std::function<std::optional<TriangleHit<T>>(const Ray<T>&, co
 template <class T>
 using SphereFn = std::function<std::optional<SurfaceHit<T>>(const Ray<T>&, const Vec3<T>&, T)>;
 
+// Another project's own intersector run as a subject (Embree, CGAL, POV-Ray's
+// arithmetic: validation/peers/): what it is, and where its speed figure
+// comes from (a per-test bench row, or the peer's whole-tracer bench where
+// no per-test time exists). Reported beside the counts, marked as a peer.
+struct PeerInfo {
+  std::string what, speed_source;
+};
+
 // An intersector under audit at one precision (only the matching callable is set).
 struct TriangleSubject {
   std::string method;
   Precision precision = Precision::f64;
   TriangleFn<float> f32;
   TriangleFn<double> f64;
+  std::optional<PeerInfo> peer;  // unset: the registry's method or a user's own
   std::string name() const { return method + "/" + precision_name(precision); }
 };
 struct SphereSubject {
@@ -149,11 +158,15 @@ struct Report {
   long long rays = 0;
   std::vector<std::string> subjects;  // "method/precision", triangles then spheres
   std::vector<std::string> kinds;     // "triangle" / "sphere", per subject
+  std::vector<std::optional<PeerInfo>> peers;  // per subject (or empty: none is a peer)
   std::vector<Cell> cells;            // subject-major, families and sweeps in order
   std::optional<Shard> shard;         // set: a shard's partial counts (to_json adds
                                       // "shard" and per-cell "histograms" for merging)
 
   Stats total(std::size_t subject) const;
+  const PeerInfo* peer(std::size_t subject) const {
+    return subject < peers.size() && peers[subject] ? &*peers[subject] : nullptr;
+  }
   const Cell* worst(std::size_t subject) const;  // nullptr when nothing went wrong
   nlohmann::json to_json() const;
   // Reads what to_json() wrote for a shard (throws std::runtime_error).

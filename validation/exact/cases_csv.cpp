@@ -1,9 +1,11 @@
 // Reading user cases and writing generated cases as CSV (see cases_csv.h);
-// numbers go through std::strtod both ways (%a on output), so the round trip is exact.
+// numbers are read with std::strtod and written as %a or as the shortest decimal
+// that reads back the same (std::to_chars), so the round trip is exact either way.
 #include "cases_csv.h"
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -24,10 +26,15 @@ const char* const kColumns[15] = {"ox", "oy", "oz", "dx", "dy", "dz", "ax", "ay"
                                   "az", "bx", "by", "bz", "cx", "cy", "cz"};
 
 
-std::string hex(double x) {
+std::string number(double x, Numbers n) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%a", x);
-  return buf;
+  if (n == Numbers::hex) {
+    std::snprintf(buf, sizeof buf, "%a", x);
+    return buf;
+  }
+  // Shortest round trip: to_chars without a precision (C++17).
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, ec == std::errc() ? end : buf);
 }
 
 
@@ -154,22 +161,22 @@ std::string cases_csv_header() {
   return out;
 }
 
-std::string cases_csv_row(const ExportRow& r) {
+std::string cases_csv_row(const ExportRow& r, Numbers n) {
   std::string out;
   out.append(r.id).append(",").append(r.family).append(",").append(r.sweep);
   const double v[15] = {r.ray.o.x, r.ray.o.y, r.ray.o.z, r.ray.d.x, r.ray.d.y, r.ray.d.z,
                         r.tri.a.x, r.tri.a.y, r.tri.a.z, r.tri.b.x, r.tri.b.y, r.tri.b.z,
                         r.tri.c.x, r.tri.c.y, r.tri.c.z};
-  for (double x : v) out.append(",").append(hex(x));
+  for (double x : v) out.append(",").append(number(x, n));
   out.append(",").append(oracle::verdict_name(r.answer.verdict)).append(",");
-  if (std::isfinite(r.answer.t)) out.append(hex(r.answer.t));
+  if (std::isfinite(r.answer.t)) out.append(number(r.answer.t, n));
   out.append("\n");
   return out;
 }
 
-std::string cases_csv(const std::vector<ExportRow>& rows) {
+std::string cases_csv(const std::vector<ExportRow>& rows, Numbers n) {
   std::string out = cases_csv_header();
-  for (const ExportRow& r : rows) out.append(cases_csv_row(r));
+  for (const ExportRow& r : rows) out.append(cases_csv_row(r, n));
   return out;
 }
 

@@ -6,7 +6,8 @@
 // consumed by std::strtod); optional id; every other column ignored. Fields
 // are separated by commas, without quoting; blank lines are skipped. The ray
 // is {o + t d : t >= 0}. The export writes id,family,sweep, the 15 inputs as
-// %a, then verdict and t (%a, empty when there is no crossing).
+// %a (or, with Numbers::decimal, the shortest decimal that reads back the
+// same double), then verdict and t (likewise, empty when there is no crossing).
 #pragma once
 #include <functional>
 #include <istream>
@@ -42,10 +43,15 @@ struct ExportRow {
   Tri tri;
   oracle::Answer answer;
 };
-std::string cases_csv(const std::vector<ExportRow>& rows);
+// How the export writes numbers: C99 hex floats (%a), or decimal, the
+// shortest text that reads back as the same double (std::to_chars), for
+// languages without a hex-float parser (JavaScript's Number() reads it
+// exactly). Both read back exactly through std::strtod.
+enum class Numbers { hex, decimal };
+std::string cases_csv(const std::vector<ExportRow>& rows, Numbers n = Numbers::hex);
 // The header line of cases_csv(), and one row of it.
 std::string cases_csv_header();
-std::string cases_csv_row(const ExportRow& r);
+std::string cases_csv_row(const ExportRow& r, Numbers n = Numbers::hex);
 
 // The generated cases of the given triangle families (the secondary family,
 // whose rays depend on each method, and sphere families are skipped).

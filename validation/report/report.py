@@ -27,6 +27,8 @@ import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image, ImageDraw  # noqa: E402
 
+import peer_subjects  # noqa: E402  (beside this file: peers marked in sections 1 and 2)
+
 plt.rcParams.update({
     "svg.fonttype": "none",  # text stays text: smaller and searchable
     "font.size": 9,
@@ -216,7 +218,7 @@ def speed_accuracy(audit, bench, methods):
             "tests": t["tests"],
             "worst": s.get("worst"),
         })
-    return out
+    return peer_subjects.annotate(out, methods, rows)
 
 
 def pareto(points):
@@ -233,9 +235,9 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
     for e, (x, y) in zip(entries, pts):
         doc = e["document_variant"]
         c = methods.colour.get(e["method"], "k")
-        ax.scatter([x], [y], s=60, marker="o" if e["precision"] == "float" else "s",
+        ax.scatter([x], [y], s=60, marker="*" if e.get("peer") else "o" if e["precision"] == "float" else "s",
                    facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=3)
-        ax.annotate(("doc: " if doc else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d"),
+        ax.annotate(("doc: " if doc else "peer: " if e.get("peer") else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d"),
                     (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6.5,
                     color=c, alpha=0.9)
     front = pareto(pts)
@@ -279,7 +281,8 @@ def chart_speed_accuracy(entries, methods, have_bench):
                 del e["_lpm"]
             charts.append((svg_of(fig), "Each point is a method x precision (circle float, square double, hollow = "
                            "a seed document's method as written). Down-left is better: the dashed line joins the "
-                           "methods nothing else beats on both speed and correctness."))
+                           "methods nothing else beats on both speed and correctness." +
+                           (peer_subjects.CAPTION if any(e.get("peer") for e in timed_tri) else "")))
         if timed_sph:
             fig, ax = plt.subplots(figsize=(6, 4.2))
             scatter_panel(ax, timed_sph, methods, "wrong_pct", "wrong % of tests (log)",
@@ -342,7 +345,8 @@ def line_panel(ax, rows, methods, field, sweeps, numeric):
         rs.sort(key=lambda r: xs_of[r["sweep"]])
         doc = methods.is_document(method)
         ax.plot([xs_of[r["sweep"]] for r in rs], [r[field] for r in rs], marker="o", ms=3,
-                ls="--" if doc else "-", color=methods.colour.get(method, "k"), label=methods.label(method))
+                ls="--" if doc else ":" if peer_subjects.is_peer(methods, method) else "-",
+                color=methods.colour.get(method, "k"), label=peer_subjects.label(methods, method))
     if numeric:
         if min(xs_of.values()) > 0:
             ax.set_xscale("log")
@@ -402,7 +406,8 @@ def chart_stability(stab, methods):
         axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1))
         how = f"as the {d['param']} grows" if numeric else f"for each {d['param']}"
         caption = (f"{family}: how each method fares {how}; float left, double right, "
-                   "dashed lines are the seed documents' methods. Flat at 0 is right; a rising line is where "
+                   "dashed lines are the seed documents' methods, dotted ones peers (other projects' own code). "
+                   "Flat at 0 is right; a rising line is where "
                    "that method breaks.")
         charts.append((family, svg_of(fig), caption))
     return charts
@@ -748,10 +753,10 @@ def page(rep, charts, methods, uris):
              '<th>leaks per million</th><th>tests</th><th class="l">breaks worst at (family@sweep)</th>'
              '<th class="l">source</th></tr>')
     for e in rep["speed_accuracy"]:
-        src = methods.by_name.get(e["method"], {}).get("source", "")
+        src = e.get("speed_source") or methods.by_name.get(e["method"], {}).get("source", "")
         w = e.get("worst")
         worst = f"{w['family']}@{w['sweep']} ({100 * w['badness']:.3g}% bad)" if w else "nowhere"
-        h.append(f'<tr><td class="l">{esc(methods.label(e["method"]))}/{esc(e["precision"])}</td>'
+        h.append(f'<tr><td class="l">{esc(peer_subjects.label(methods, e["method"]))}/{esc(e["precision"])}</td>'
                  f"<td>{fnum(e['ns_per_test'])}</td><td>{fnum(e['wrong_pct'])}</td><td>{e['leaks']}</td>"
                  f"<td>{fnum(e['leaks_per_million'])}</td><td>{e['tests']}</td>"
                  f"<td class=\"l\">{esc(worst)}</td><td class=\"l\">{esc(src)}</td></tr>")
@@ -872,6 +877,7 @@ def main():
         ctx[k] = [os.fsdecode(bytes.fromhex(h)) for h in v] if isinstance(v, list) else os.fsdecode(bytes.fromhex(v))
     methods = Methods(ctx["methods"])
     audit = load_json(ctx["audit"])
+    peer_subjects.register(methods, audit)
     bench = None
     if ctx.get("bench"):
         bench = load_json(ctx["bench"])
