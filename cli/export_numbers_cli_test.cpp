@@ -81,7 +81,7 @@ TEST(ExportNumbers, GradeReadsHexAndDecimalAnswersAlike) {
   // Both answer files named alike, so both subjects are "ans/double".
   fs::create_directories(scratch("hex")), fs::create_directories(scratch("dec"));
   const fs::path cases = scratch("g-cases.csv"), hex = scratch("hex/ans.csv"), dec = scratch("dec/ans.csv");
-  ASSERT_EQ(run_rayaudit("audit --export-cases " + cases.string() + " --numbers decimal --families edge --rays 400").code, 0);
+  ASSERT_EQ(run_rayaudit("audit --export-cases " + cases.string() + " --numbers decimal --families edge --rays 2000").code, 0);
   // The exact t of each crossing as the answer: hex from the value, decimal
   // as the export wrote it.
   const auto rs = rows(cases);

@@ -56,14 +56,15 @@ TEST(ThreeJsExample, GradesRayIntersectTriangleThroughNode) {
   ASSERT_EQ(j["subjects"].size(), 1u);
   EXPECT_EQ(j["subjects"][0]["name"], "three/double");
   const auto& t = j["subjects"][0]["totals"];
-  // The figures of three r187 (README.md in validation/peers/), with room
-  // for another release's rounding but not for another algorithm: its
-  // sheared edge functions are evaluated alike for a shared edge, so no ray
-  // falls between two triangles.
+  // three r187 (pinned by ci/fetch-corpus.sh) gave 58,320 tests, 0.0086%
+  // wrong (3 false hits, 2 false misses), 0 leaks in 14,286 groups, 1 double
+  // hit (README.md in validation/peers/). The bounds are an order of
+  // magnitude above that, and leaks stay 0: its sheared edge functions are
+  // evaluated alike for a shared edge, so no ray falls between two triangles.
   EXPECT_GT(t["tests"].get<std::uint64_t>(), 50000u);
   EXPECT_GT(t["groups"].get<std::uint64_t>(), 5000u);
   EXPECT_EQ(t["leaks"], 0) << g.out;
-  EXPECT_LE(t["double_hits"].get<std::uint64_t>(), std::uint64_t(1000000)) << g.out;
-  EXPECT_LE(t["wrong_pct"].get<double>(), 100.0) << g.out;
+  EXPECT_LE(t["double_hits"].get<std::uint64_t>(), 10u) << g.out;
+  EXPECT_LE(t["wrong_pct"].get<double>(), 0.1) << g.out;
   EXPECT_EQ(t["nan_inf"], 0) << g.out;
 }
