@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Command 1 of the README: install what is missing, build, and run the main
 # job on the scenes shipped in scenes/, into OUT (default out/): every scene
-# rendered (OUT/renders), every method audited against exact arithmetic
-# (OUT/audit), every scene POV-Ray can express compared with POV-Ray 3.7
+# rendered (OUT/renders), every method and peer audited against exact
+# arithmetic (OUT/audit), every scene POV-Ray can express compared with POV-Ray 3.7
 # (OUT/pov) and checked against its golden image (OUT/golden-diffs on a
 # difference), crack maps drawn (OUT/crack-maps), the quick benchmark
 # written to OUT/bench/bench.json (Google Benchmark's JSON; the console
@@ -46,9 +46,9 @@ stage "render" "rendering scenes/*.json and the mesh ladder scenes/corpus/*.json
 n=0 total=$(count_of scenes/*.json scenes/corpus/*.json)
 for scene in scenes/*.json scenes/corpus/*.json; do n=$((n + 1)); printf '[%d/%d] ' "$n" "$total"; render "$scene"; done
 
-stage "audit" "auditing every method against exact arithmetic into $OUT/audit"
-echo "rayaudit audit --rays 200000 --json $OUT/audit/audit.json --csv $OUT/audit/audit.csv"
-"$RAYAUDIT" audit --rays 200000 --json "$OUT/audit/audit.json" --csv "$OUT/audit/audit.csv" | tee "$OUT/audit/table.txt"
+stage "audit" "auditing every method and peer (Embree, CGAL, POV-Ray's mesh2 test) against exact arithmetic into $OUT/audit"
+echo "rayaudit audit --methods all --rays 200000 --json $OUT/audit/audit.json --csv $OUT/audit/audit.csv"
+"$RAYAUDIT" audit --methods all --rays 200000 --json "$OUT/audit/audit.json" --csv "$OUT/audit/audit.csv" | tee "$OUT/audit/table.txt"
 
 failed=0
 compare() {

@@ -76,3 +76,14 @@ def annotate(entries, methods, rows):
 CAPTION = (" Stars are peers, other projects' own code run by the audit (validation/peers/); a peer's x is its "
            "whole tracer's time per ray (POV-Ray: per pixel) from the peer bench, named in the table, as no per-test "
            "time exists.")
+
+
+def legend(row):
+    """One legend right of a row of panels, naming every line of any panel: a
+    peer answers at one precision only, so its line is in one panel alone."""
+    handles = {}
+    for ax in row:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    row[-1].legend(list(handles.values()), list(handles.keys()), fontsize=6.5, loc="upper left",
+                   bbox_to_anchor=(1.01, 1))

@@ -381,7 +381,7 @@ def chart_stability(stab, methods):
                     line_panel(axes[i][j], rs, methods, "self_hit_pct", sw, True)
                     axes[i][j].set_title(f"{st}, {p}: self-hit % of secondary rays")
                     axes[i][j].set_xlabel("scale of the triangle (log)")
-            axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1))
+            peer_subjects.legend(axes[0])
             caption = ("secondary: rays spawned from each method's own hit under each self-intersection strategy; "
                        "a self-hit re-hits the triangle it left (shadow acne). Lower is better; 0 is the goal.")
             charts.append((family, svg_of(fig), caption))
@@ -403,7 +403,7 @@ def chart_stability(stab, methods):
             top = max(ax.get_ylim()[1] for ax in axes[i])
             for ax in axes[i]:
                 ax.set_ylim(0, top)
-        axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1))
+        peer_subjects.legend(axes[0])
         how = f"as the {d['param']} grows" if numeric else f"for each {d['param']}"
         caption = (f"{family}: how each method fares {how}; float left, double right, "
                    "dashed lines are the seed documents' methods, dotted ones peers (other projects' own code). "
