@@ -11,8 +11,9 @@
 //
 // One scene per thread and flag is kept and rebuilt for every test: the
 // vertex buffer rewritten in place, rtcUpdateGeometryBuffer, rtcCommitGeometry
-// and rtcCommitScene: about 11 us a test on this machine, one thread (a refit
-// build quality took 13 us, RTC_BUILD_QUALITY_LOW 22 us: README.md). The thread's
+// and rtcCommitScene: about 3 us of CPU a test in the audit (README.md); in a
+// standalone loop a refit build quality and RTC_BUILD_QUALITY_LOW were both
+// slower than the default (13 and 22 us against 11, a loaded machine). The thread's
 // floating-point modes are left as they are: Embree recommends flush-to-zero
 // and denormals-are-zero, which would change the other subjects' arithmetic
 // on the same thread.
