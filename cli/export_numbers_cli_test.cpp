@@ -46,7 +46,8 @@ std::vector<std::vector<std::string>> rows(const fs::path& p) {
 
 TEST(ExportNumbers, DecimalReadsBackAsTheHexExportsDoubles) {
   for (const char* prec : {"float", "double"}) {
-    const fs::path hex = scratch(std::string("hex-") + prec + ".csv"), dec = scratch(std::string("dec-") + prec + ".csv");
+    const fs::path hex = scratch(std::string("hex-") + prec + ".csv"),
+                   dec = scratch(std::string("dec-") + prec + ".csv");
     const std::string common = std::string(" --precision ") + prec + " --families edge,vertex,near-miss --rays 600";
     ASSERT_EQ(run_rayaudit("audit --export-cases " + hex.string() + common).code, 0);
     const auto r = run_rayaudit("audit --export-cases " + dec.string() + common + " --numbers decimal");
@@ -81,7 +82,9 @@ TEST(ExportNumbers, GradeReadsHexAndDecimalAnswersAlike) {
   // Both answer files named alike, so both subjects are "ans/double".
   fs::create_directories(scratch("hex")), fs::create_directories(scratch("dec"));
   const fs::path cases = scratch("g-cases.csv"), hex = scratch("hex/ans.csv"), dec = scratch("dec/ans.csv");
-  ASSERT_EQ(run_rayaudit("audit --export-cases " + cases.string() + " --numbers decimal --families edge --rays 2000").code, 0);
+  ASSERT_EQ(
+      run_rayaudit("audit --export-cases " + cases.string() + " --numbers decimal --families edge --rays 2000").code,
+      0);
   // The exact t of each crossing as the answer: hex from the value, decimal
   // as the export wrote it.
   const auto rs = rows(cases);
@@ -98,8 +101,10 @@ TEST(ExportNumbers, GradeReadsHexAndDecimalAnswersAlike) {
   }
   h.close(), d.close();
   const fs::path jh = scratch("gh.json"), jd = scratch("gd.json");
-  const auto a = run_rayaudit("audit --grade " + hex.string() + " --cases " + cases.string() + " --json " + jh.string());
-  const auto b = run_rayaudit("audit --grade " + dec.string() + " --cases " + cases.string() + " --json " + jd.string());
+  const auto a =
+      run_rayaudit("audit --grade " + hex.string() + " --cases " + cases.string() + " --json " + jh.string());
+  const auto b =
+      run_rayaudit("audit --grade " + dec.string() + " --cases " + cases.string() + " --json " + jd.string());
   ASSERT_EQ(a.code, 0) << a.all;
   ASSERT_EQ(b.code, 0) << b.all;
   const auto ja = nlohmann::json::parse(slurp(jh)), jb = nlohmann::json::parse(slurp(jd));

@@ -47,7 +47,8 @@ std::optional<TriangleHit<double>> cgal_hit(const Rayd& r, const Vec3d& a, const
   // shade, and the answer is a miss.
   if (!x) return std::nullopt;
   double t;
-  if (const K::Point_3* p = boost::get<K::Point_3>(&*x)) t = t_of(r, *p);
+  if (const K::Point_3* p = boost::get<K::Point_3>(&*x))
+    t = t_of(r, *p);
   else {
     const K::Segment_3& s = *boost::get<K::Segment_3>(&*x);
     t = std::min(t_of(r, s.source()), t_of(r, s.target()));

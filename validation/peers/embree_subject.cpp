@@ -55,7 +55,8 @@ class OneTriangle {
     v_[0] = v_[1] = v_[2] = v_[3] = v_[4] = v_[5] = v_[6] = v_[7] = v_[8] = 0;
     rtcCommitGeometry(geom_);
     rtcAttachGeometry(scene_, geom_);
-    if (rtcGetDeviceError(dev) != RTC_ERROR_NONE) throw std::runtime_error("Embree: making a one-triangle scene failed");
+    if (rtcGetDeviceError(dev) != RTC_ERROR_NONE)
+      throw std::runtime_error("Embree: making a one-triangle scene failed");
   }
   OneTriangle(const OneTriangle&) = delete;
   OneTriangle& operator=(const OneTriangle&) = delete;
@@ -104,9 +105,10 @@ OneTriangle& scene_for(bool robust) {
 bool have_embree() { return true; }
 
 audit::TriangleSubject embree_subject(bool robust) {
-  return audit::triangle_subject<float>(
-      robust ? "embree-robust" : "embree",
-      [robust](const Rayf& r, const Vec3f& a, const Vec3f& b, const Vec3f& c) { return scene_for(robust).hit(r, a, b, c); });
+  return audit::triangle_subject<float>(robust ? "embree-robust" : "embree",
+                                        [robust](const Rayf& r, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+                                          return scene_for(robust).hit(r, a, b, c);
+                                        });
 }
 
 }  // namespace ra::peers

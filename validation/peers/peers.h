@@ -15,10 +15,10 @@
 namespace ra::peers {
 
 struct Peer {
-  std::string name;         // as --methods takes it
+  std::string name;  // as --methods takes it
   audit::Precision precision;
-  audit::PeerInfo info;     // what it is, where its speed figure comes from
-  std::string missing;      // empty when in this build; else how to get it
+  audit::PeerInfo info;                        // what it is, where its speed figure comes from
+  std::string missing;                         // empty when in this build; else how to get it
   audit::TriangleSubject (*make)() = nullptr;  // set when in this build
 };
 

@@ -40,16 +40,16 @@ TEST(ThreeJsExample, GradesRayIntersectTriangleThroughNode) {
   }
   const fs::path cases = scratch("cases.csv"), answers = scratch("three.csv"), json = scratch("graded.json");
   const auto ex = run_rayaudit("audit --export-cases " + cases.string() +
-                              " --numbers decimal --families edge,vertex,closed-mesh --rays 20000");
+                               " --numbers decimal --families edge,vertex,closed-mesh --rays 20000");
   ASSERT_EQ(ex.code, 0) << ex.all;
   const std::string text = slurp(cases);
   ASSERT_EQ(text.find("0x"), std::string::npos) << "decimal numbers only: JavaScript reads no hex floats";
   const std::string script = std::string(RAYAUDIT_SOURCE_DIR) + "/examples/grade/three_intersect_triangle.mjs";
-  const std::string cmd = "node '" + script + "' '" + three.string() + "' '" + cases.string() + "' '" +
-                          answers.string() + "'";
+  const std::string cmd =
+      "node '" + script + "' '" + three.string() + "' '" + cases.string() + "' '" + answers.string() + "'";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << " (node: Debian's nodejs, ci/install-deps.sh)";
-  const auto g = run_rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " +
-                              json.string());
+  const auto g =
+      run_rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string());
   ASSERT_EQ(g.code, 0) << g.all;
   std::printf("%s", g.out.c_str());
   const auto j = nlohmann::json::parse(slurp(json));
