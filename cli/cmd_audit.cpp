@@ -113,9 +113,8 @@ Chosen chosen_subjects(const std::string& list) {
     }
     const ra::Method* m = ra::find_method(name);
     if (!m)
-      throw ra::InputError("audit: unknown method '" + name + "' (triangle: " +
-                           ra::method_names(ra::Kind::triangle) + "; sphere: " +
-                           ra::method_names(ra::Kind::sphere) + "; peers: " + ra::peers::peer_names() +
+      throw ra::InputError("audit: unknown method '" + name + "' (triangle: " + ra::method_names(ra::Kind::triangle) +
+                           "; sphere: " + ra::method_names(ra::Kind::sphere) + "; peers: " + ra::peers::peer_names() +
                            "; or all, peers)");
     if (m->kind == ra::Kind::plane)
       throw ra::InputError("audit: '" + name + "' is a plane method; the audit grades triangles and spheres");

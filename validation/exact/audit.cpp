@@ -591,8 +591,10 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
   Report rep;
   rep.seed = opt.seed;
   rep.rays = opt.rays;
-  for (const auto& s : tris) rep.subjects.push_back(s.name()), rep.kinds.push_back("triangle"), rep.peers.push_back(s.peer);
-  for (const auto& s : spheres) rep.subjects.push_back(s.name()), rep.kinds.push_back("sphere"), rep.peers.emplace_back();
+  for (const auto& s : tris)
+    rep.subjects.push_back(s.name()), rep.kinds.push_back("triangle"), rep.peers.push_back(s.peer);
+  for (const auto& s : spheres)
+    rep.subjects.push_back(s.name()), rep.kinds.push_back("sphere"), rep.peers.emplace_back();
 
   std::vector<const Family*> fams;
   for (const Family& f : families()) {
@@ -728,15 +730,15 @@ nlohmann::json Report::to_json() const {
   for (std::size_t i = 0; i < subjects.size(); ++i) {
     const Cell* w = worst(i);
     const auto slash = subjects[i].rfind('/');
-    subs.push_back({{"name", subjects[i]},
-                    {"method", subjects[i].substr(0, slash)},
-                    {"precision", subjects[i].substr(slash + 1)},
-                    {"kind", kinds[i]},
-                    {"peer", peer(i) != nullptr},
-                    {"totals", total(i).to_json()},
-                    {"worst", w ? nlohmann::json{{"family", w->family}, {"sweep", w->sweep_label},
-                                                 {"badness", w->stats.badness()}}
-                                : nlohmann::json(nullptr)}});
+    subs.push_back(
+        {{"name", subjects[i]},
+         {"method", subjects[i].substr(0, slash)},
+         {"precision", subjects[i].substr(slash + 1)},
+         {"kind", kinds[i]},
+         {"peer", peer(i) != nullptr},
+         {"totals", total(i).to_json()},
+         {"worst", w ? nlohmann::json{{"family", w->family}, {"sweep", w->sweep_label}, {"badness", w->stats.badness()}}
+                     : nlohmann::json(nullptr)}});
     if (const PeerInfo* p = peer(i)) subs.back()["what"] = p->what, subs.back()["speed_source"] = p->speed_source;
   }
   for (const Cell& c : cells) {
@@ -880,13 +882,11 @@ std::string Report::to_csv() const {
     const std::string& n = subjects[c.subject];
     const auto slash = n.rfind('/');
     os << csv_field(n.substr(0, slash)) << ',' << csv_field(n.substr(slash + 1)) << ',' << csv_field(c.family) << ','
-       << csv_field(c.sweep_label)
-       << ',' << s.tests << ',' << s.wrong() << ',' << s.true_hits << ',' << s.false_hits << ','
-       << s.true_misses << ',' << s.false_misses << ','
-       << s.wrong_t << ',' << s.boundary_hits << ',' << s.boundary_misses << ',' << s.coplanar_hits
-       << ',' << s.coplanar_misses << ',' << s.degenerate_hits << ',' << s.degenerate_misses << ','
-       << s.nan_inf << ',' << s.groups << ',' << s.leaks << ',' << s.double_hits << ',' << s.spawned
-       << ',' << s.self_hits << ',' << s.median_ulps() << ',' << s.max_ulps << ','
+       << csv_field(c.sweep_label) << ',' << s.tests << ',' << s.wrong() << ',' << s.true_hits << ',' << s.false_hits
+       << ',' << s.true_misses << ',' << s.false_misses << ',' << s.wrong_t << ',' << s.boundary_hits << ','
+       << s.boundary_misses << ',' << s.coplanar_hits << ',' << s.coplanar_misses << ',' << s.degenerate_hits << ','
+       << s.degenerate_misses << ',' << s.nan_inf << ',' << s.groups << ',' << s.leaks << ',' << s.double_hits << ','
+       << s.spawned << ',' << s.self_hits << ',' << s.median_ulps() << ',' << s.max_ulps << ','
        << fmt("%.6g", s.median_rel()) << ',' << fmt("%.6g", s.max_rel) << ',' << (peer(c.subject) ? 1 : 0) << '\n';
   }
   return os.str();

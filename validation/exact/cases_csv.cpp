@@ -25,7 +25,6 @@ namespace {
 const char* const kColumns[15] = {"ox", "oy", "oz", "dx", "dy", "dz", "ax", "ay",
                                   "az", "bx", "by", "bz", "cx", "cy", "cz"};
 
-
 std::string number(double x, Numbers n) {
   char buf[64];
   if (n == Numbers::hex) {
@@ -36,7 +35,6 @@ std::string number(double x, Numbers n) {
   const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, x);
   return std::string(buf, ec == std::errc() ? end : buf);
 }
-
 
 // A column named twice would make one of the two silently ignored.
 void check_unique_columns(const std::string& path, long lineno, const std::vector<std::string>& header) {
