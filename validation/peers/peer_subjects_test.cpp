@@ -78,7 +78,7 @@ constexpr int kRays = 4000;
 TEST(PeerSubjects, AuditAgreesWithGradingThePeersAnswers) {
   std::string names;
   for (const auto& p : ra::peers::peers())
-    if (p.make) names += (names.empty() ? "" : ",") + p.name;
+    if (p.make) names.append(names.empty() ? "" : ",").append(p.name);
   ASSERT_FALSE(names.empty());
   const fs::path json = scratch("peers.json"), csv = scratch("peers.csv");
   const auto run = run_rayaudit("audit --methods " + names + ",moller --families " + kFamilies + " --rays " +

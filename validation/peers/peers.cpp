@@ -58,7 +58,8 @@ const Peer* find_peer(std::string_view name) {
 
 std::string peer_names() {
   std::string out;
-  for (const Peer& p : peers()) out += (out.empty() ? "" : ", ") + p.name;
+  // Appended piece by piece (GCC 12 warns falsely on `", " + std::string`).
+  for (const Peer& p : peers()) out.append(out.empty() ? "" : ", ").append(p.name);
   return out;
 }
 
