@@ -566,9 +566,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--csv", a->csv, "Write one row per method x precision x family x sweep value");
   auto* cases = cmd->add_option("--cases", a->cases,
                                 "Audit the cases of this CSV (columns ox..cz, optional id) instead of generating");
-  auto* exp = cmd->add_option("--export-cases", a->export_cases,
-                              "Write the generated cases with exact verdicts as a CSV of C99 hex floats")
-                   ->excludes(cases);
+  auto* exp =
+      cmd->add_option("--export-cases", a->export_cases,
+                      "Write the generated cases with exact verdicts as a CSV (C99 hex floats, or --numbers decimal)")
+          ->excludes(cases);
   cmd->add_option("--numbers", a->numbers,
                   "--export-cases writes numbers as C99 hex floats (hex) or as the shortest decimals that read back "
                   "exactly (decimal: for languages without hex floats)")
