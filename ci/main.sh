@@ -47,8 +47,8 @@ n=0 total=$(count_of scenes/*.json scenes/corpus/*.json)
 for scene in scenes/*.json scenes/corpus/*.json; do n=$((n + 1)); printf '[%d/%d] ' "$n" "$total"; render "$scene"; done
 
 stage "audit" "auditing every method against exact arithmetic into $OUT/audit"
-echo "rayaudit audit --rays 200000 --json $OUT/audit/audit.json --csv $OUT/audit/audit.csv"
-"$RAYAUDIT" audit --rays 200000 --json "$OUT/audit/audit.json" --csv "$OUT/audit/audit.csv" | tee "$OUT/audit/table.txt"
+echo "rayaudit audit --rays 200000 --tracers bvh,sphere,none,embree,embree-robust,cgal-aabb --json $OUT/audit/audit.json --csv $OUT/audit/audit.csv"
+"$RAYAUDIT" audit --rays 200000 --tracers bvh,sphere,none,embree,embree-robust,cgal-aabb --json "$OUT/audit/audit.json" --csv "$OUT/audit/audit.csv" | tee "$OUT/audit/table.txt"
 
 failed=0
 compare() {
