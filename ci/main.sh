@@ -46,9 +46,9 @@ stage "render" "rendering scenes/*.json and the mesh ladder scenes/corpus/*.json
 n=0 total=$(count_of scenes/*.json scenes/corpus/*.json)
 for scene in scenes/*.json scenes/corpus/*.json; do n=$((n + 1)); printf '[%d/%d] ' "$n" "$total"; render "$scene"; done
 
-stage "audit" "auditing every method and peer (Embree, CGAL, POV-Ray's mesh2 test) against exact arithmetic into $OUT/audit"
-echo "rayaudit audit --methods all --rays 200000 --json $OUT/audit/audit.json --csv $OUT/audit/audit.csv"
-"$RAYAUDIT" audit --methods all --rays 200000 --json "$OUT/audit/audit.json" --csv "$OUT/audit/audit.csv" | tee "$OUT/audit/table.txt"
+stage "audit" "auditing every method and peer (Embree, CGAL, POV-Ray's mesh2 test) and whole tracers against exact arithmetic into $OUT/audit"
+echo "rayaudit audit --methods all --rays 200000 --tracers bvh,sphere,none,embree,embree-robust,cgal-aabb --json $OUT/audit/audit.json --csv $OUT/audit/audit.csv"
+"$RAYAUDIT" audit --methods all --rays 200000 --tracers bvh,sphere,none,embree,embree-robust,cgal-aabb --json "$OUT/audit/audit.json" --csv "$OUT/audit/audit.csv" | tee "$OUT/audit/table.txt"
 
 failed=0
 compare() {

@@ -27,6 +27,7 @@
 #include "io/json_input.h"
 #include "peers.h"
 #include "registry.h"
+#include "tracers/tracers.h"
 
 namespace {
 
@@ -43,6 +44,8 @@ constexpr long long kMaxExportRays = 10000000;
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
   std::string numbers = "hex";  // --export-cases: hex or decimal
+  std::string tracers;              // --tracers: whole tracers on closed meshes (validation/tracers)
+  long long tracer_rays = 2000;     // --tracer-rays: per shape, placement and scale
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
@@ -354,6 +357,15 @@ void export_cases(const Args& a) {
 // ------------------------------------------------------------ audit ---
 void audit(const Args& a) {
   ra::OutputBatch outputs({a.json, a.csv});
+  // Whole tracers (--tracers): named before anything runs (an unknown name
+  // lists the known ones); graded after the kernels, into the same JSON.
+  std::vector<ra::tracers::Subject> tracer_subjects;
+  if (!a.tracers.empty())
+    for (const auto& name : split_list(a.tracers, "--tracers")) try {
+        for (auto& s : ra::tracers::named(name)) tracer_subjects.push_back(std::move(s));
+      } catch (const std::invalid_argument& e) {
+        throw ra::InputError(std::string("audit: --tracers: ") + e.what());
+      }
   const Chosen chosen = chosen_subjects(a.methods);
   const auto& ms = chosen.methods;
   const auto ps = chosen_precisions(a.precision);
@@ -404,7 +416,16 @@ void audit(const Args& a) {
   std::fputs(rep.summary_table().c_str(), stdout);
   if (opt.shard)
     std::printf("shard %s: partial counts; combine every shard's --json with `rayaudit audit merge`\n", a.shard.c_str());
-  if (!a.json.empty()) ra::write_text_atomically(a.json, rep.to_json().dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  nlohmann::json out = rep.to_json();
+  if (!tracer_subjects.empty()) {
+    ra::tracers::Options to;
+    to.rays = a.tracer_rays;
+    to.seed = a.seed;
+    const ra::tracers::Report tr = ra::tracers::run(tracer_subjects, to);
+    std::fputs(tr.summary_table().c_str(), stdout);
+    out["tracers"] = tr.to_json();
+  }
+  if (!a.json.empty()) ra::write_text_atomically(a.json, out.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
 }
@@ -563,6 +584,11 @@ void setup(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--json", a->json, "Write every count to this JSON file");
+  cmd->add_option("--tracers", a->tracers,
+                  "Also grade whole tracers on closed meshes placed out to 1e7 and scaled 1e-4..1e4 (the JSON's "
+                  "\"tracers\"): " + ra::tracers::known_names());
+  cmd->add_option("--tracer-rays", a->tracer_rays, "Rays per closed mesh, placement and scale for --tracers (default 2000)")
+      ->check(CLI::Range(2LL, 100000000LL));
   cmd->add_option("--csv", a->csv, "Write one row per method x precision x family x sweep value");
   auto* cases = cmd->add_option("--cases", a->cases,
                                 "Audit the cases of this CSV (columns ox..cz, optional id) instead of generating");

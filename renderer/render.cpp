@@ -89,6 +89,7 @@ struct PreparedMesh {
   double bs_radius = 0;
   Vec3d lo, hi;      // the box of its vertices, padded by `pad` (the BVH's padding)
   double pad = 0;
+  double scale = 0;  // max(its size, its farthest coordinate): pad = 1e-5 scale
   std::uint32_t one_leaf = Bvh::kEmpty;  // the BVH's only leaf, when it has one (at most 4 triangles)
   bool cull = false;  // --cull, and the mesh is closed (cull_unsafe_reason)
 };
@@ -108,6 +109,30 @@ Vec3d unit_normal(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   const Vec3d n = cross(b - a, c - a);  // length = twice the area
   const double len = length(n);
   return len > 0 ? n / len : Vec3d{0, 0, 0};
+}
+
+// A kernel's hits stray from their triangle by a few roundings of the
+// magnitudes it subtracts (o - v, or o + t d): at precision T, about
+// kReachRoundings 2^-24 (or 2^-53) times |o| + |v| (max norm). The BVH's
+// padding (1e-5 of the mesh's scale, 168 float roundings) covers that for
+// origins within about 9 scales of the mesh: shadow and reflected rays,
+// most cameras. A ray from farther out (a camera at 1e5 looking at a unit
+// mesh at the origin, 0.01 of rounding at every subtraction, more at a
+// grazing angle) is moved along itself first, in double, to just before
+// the mesh's bounding sphere (shift), and every mesh test, --accel none,
+// sphere or bvh, sees that ray rounded to T: the same kernel answers for
+// all three, and its hits are as near their triangles as a near ray's.
+// Its t is t0 + the kernel's t.
+constexpr double kReachRoundings = 16;
+template <class T>
+constexpr double unit_roundoff() {
+  return sizeof(T) == 4 ? 0x1p-24 : 0x1p-53;
+}
+// The least T at or above x (the window's tmax for a t that T may not hold).
+template <class T>
+[[gnu::always_inline]] inline T t_above(double x) {
+  if constexpr (sizeof(T) == 4) return bvh_detail::round_up(x);
+  else return x;
 }
 
 // Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
@@ -165,6 +190,25 @@ struct Tracer::Impl {
       if (!fresh) continue;
       if (opt.use_double) meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
       else meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
+    }
+    // The sphere far rays are moved to (shift): around every mesh, with the
+    // least padding and the largest scale among them.
+    {
+      Vec3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+      auto each = [&](const auto& ms) {
+        for (const auto& m : ms) {
+          lo = vmin(lo, m.lo);
+          hi = vmax(hi, m.hi);
+          meshes_pad = std::min(meshes_pad, m.pad);
+          meshes_scale = std::max(meshes_scale, m.scale);
+        }
+      };
+      if (opt.use_double) each(meshes_d);
+      else each(meshes_f);
+      if (meshes_scale > 0) {
+        meshes_center = (lo + hi) * 0.5;
+        meshes_radius = length(hi - lo) * 0.5;
+      }
     }
     build_object_bvh();
     one_mesh_tri4 = avx2 && s.objects.size() == 1 && s.objects[0].kind == Object::Kind::mesh && !opt.pov_mesh_intersect &&
@@ -284,6 +328,20 @@ struct Tracer::Impl {
       }
       reach = std::max(reach, std::max(far(lo[k]), far(hi[k])));
     }
+    // A mesh's box is padded for rays from near it; the object BVH tests
+    // the ray from anywhere within `reach` (a far camera) while the meshes'
+    // kernels see it moved and rounded again (shift), off its line by a
+    // few roundings of `reach`: the boxes are widened by that.
+    for (std::size_t k = 0; k < objs.size(); ++k) {
+      const Object& o = scene.objects[std::size_t(objs[k])];
+      if (o.kind != Object::Kind::mesh) continue;
+      const std::size_t mi = std::size_t(mesh_index[std::size_t(objs[k])]);
+      const double scale = opt.use_double ? meshes_d[mi].scale : meshes_f[mi].scale;
+      const double w = kReachRoundings * (opt.use_double ? unit_roundoff<double>() : unit_roundoff<float>()) *
+                       (reach + scale) * (1 + 0x1p-20);
+      lo[k] = lo[k] - Vec3d{w, w, w};
+      hi[k] = hi[k] + Vec3d{w, w, w};
+    }
     const double eps = opt.use_double ? 0x1p-52 : 0x1p-23;
     const double sphere_pad = 2 * std::sqrt(256 * eps) * 2 * reach;
     for (std::size_t k = 0; k < objs.size(); ++k) {
@@ -369,7 +427,8 @@ struct Tracer::Impl {
     // kernel answers for the ray rounded to float, whose origin far out
     // moves by 2^-24 of its distance (at 1e6, 0.06), so its hits can lie
     // outside the mesh's exact sphere (hostile pass: 182 pixels lost at 1e6).
-    m.pad = 1e-5 * std::max(length(hi - lo), std::max(max_component(abs(lo)), max_component(abs(hi))));
+    m.scale = std::max(length(hi - lo), std::max(max_component(abs(lo)), max_component(abs(hi))));
+    m.pad = 1e-5 * m.scale;
     m.lo = lo - Vec3d{m.pad, m.pad, m.pad};
     m.hi = hi + Vec3d{m.pad, m.pad, m.pad};
     if (opt.accel == Accel::bvh) build_bvh(m, k, lo, hi);
@@ -493,6 +552,36 @@ struct Tracer::Impl {
     walk_mesh<kClosest, kFma>(m, boxed, o, d, tmin, tmax, leaf, [](std::uint32_t) {});
   }
 
+  // Where a ray from far out is moved to before the meshes' kernels see it
+  // (kReachRoundings): 0 (not moved) for an origin within reach of the
+  // padding, else the t a diameter before the meshes' bounding sphere's
+  // nearest point to the line (never behind the origin). One t for every
+  // mesh of the scene, so that a mesh's triangles see the same ray
+  // whichever way they are reached (as meshes of their own with --accel
+  // none or sphere, through the object BVH or in the lone triangles' soup).
+  Vec3d meshes_center;
+  double meshes_radius = 0, meshes_pad = 1e300, meshes_scale = 0;
+  template <class T>
+  [[gnu::always_inline]] inline double shift(const Ray<double>& r) const {
+    if (!(kReachRoundings * unit_roundoff<T>() * (max_component(abs(r.o)) + meshes_scale) > meshes_pad)) return 0;
+    const double dd = dot(r.d, r.d);
+    const double t = dot(meshes_center - r.o, r.d) / dd - 2 * meshes_radius / std::sqrt(dd);
+    return t > 0 && t < 1e300 ? t : 0;
+  }
+  // The ray r moved by t0 and rounded to T, its window [r.tmin, tmax] in
+  // its own t (tmax rounded up: a tie at the best hit so far still counts).
+  template <class T>
+  static Ray<T> moved(const Ray<double>& r, double t0, double tmax) {
+    return {Vec3<T>(r.o + r.d * t0), Vec3<T>(r.d), T(r.tmin - t0), t_above<T>(tmax - t0)};
+  }
+  // The same for an any-hit ray already in T.
+  template <class T>
+  [[gnu::always_inline]] inline Ray<T> moved_any(const Ray<T>& r) const {
+    const Ray<double> rd(r);
+    const double t0 = shift<T>(rd);
+    return t0 != 0 ? moved<T>(rd, t0, rd.tmax) : r;
+  }
+
   template <class T>
   const std::vector<PreparedMesh<T>>& meshes() const {
     if constexpr (sizeof(T) == 4) return meshes_f; else return meshes_d;
@@ -539,11 +628,13 @@ struct Tracer::Impl {
   [[gnu::always_inline]] inline std::optional<SceneHit> closest_one_mesh(const Ray<double>& rd, bool cull) const {
     SceneHit best;
     best.t = std::numeric_limits<double>::infinity();
-    Ray<T> window(rd);
-    closest_in_tri4<true>(meshes<T>()[0], false, window, 0, cull && meshes<T>()[0].cull,
+    const auto& m = meshes<T>()[0];
+    const double t0 = shift<T>(rd);  // as closest_impl's
+    Ray<T> window = t0 != 0 ? moved<T>(rd, t0, rd.tmax) : Ray<T>(rd);
+    closest_in_tri4<true>(m, false, window, 0, cull && m.cull,
                           [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
-                            if (nearer(t, obj, prim, best)) {
-                              best = {t, obj, prim, b1, b2};
+                            if (nearer(t0 + t, obj, prim, best)) {
+                              best = {t0 + t, obj, prim, b1, b2};
                               window.tmax = T(t);
                             }
                           });
@@ -557,7 +648,7 @@ struct Tracer::Impl {
   }
   template <class T>
   [[gnu::target("avx2,fma"), gnu::noinline]] bool occluded_one_mesh_avx2(const Ray<T>& r) const {
-    return any_in_tri4<true>(meshes<T>()[0], false, r);
+    return any_in_tri4<true>(meshes<T>()[0], false, moved_any(r));
   }
   // The same compiled for AVX-512 (F, VL, DQ, BW) where the CPU has it: the
   // same instructions' results, with 32 vector registers (fewer values
@@ -571,7 +662,7 @@ struct Tracer::Impl {
   template <class T>
   [[gnu::target("avx2,fma,avx512f,avx512vl,avx512dq,avx512bw"), gnu::noinline]] bool occluded_one_mesh_avx512(
       const Ray<T>& r) const {
-    return any_in_tri4<true>(meshes<T>()[0], false, r);
+    return any_in_tri4<true>(meshes<T>()[0], false, moved_any(r));
   }
 
   // Closest hit at precision T. The ray arrives in double (shading is done in
@@ -591,7 +682,7 @@ struct Tracer::Impl {
     auto consider = [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
       if (nearer(t, obj, prim, best)) {
         best = {t, obj, prim, b1, b2};
-        window.tmax = T(t);
+        window.tmax = t_above<T>(t);
       }
     };
     // boxed: the object BVH has just tested the object's box.
@@ -616,27 +707,34 @@ struct Tracer::Impl {
               if (h.t >= double(window.tmin) && h.t <= double(window.tmax)) consider(h.t, int(oi), h.prim, h.b1, h.b2);
             break;
           }
+          // The ray this mesh's kernels see (shift): the window itself, or
+          // from far out moved to just before the mesh; hits at t0 + t.
+          const double t0 = shift<T>(rd);
+          Ray<T> lr = window;
+          if (t0 != 0) lr = moved<T>(rd, t0, best.t);
+          auto local = [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
+            consider(t0 + t, obj, prim, b1, b2);
+            lr.tmax = std::min(lr.tmax, T(t));
+          };
           if (opt.accel == Accel::bvh) {
             if (!m.tri4.empty()) {
-              closest_in_tri4<kFma>(m, boxed, window, int(oi), cull && m.cull, consider);
+              closest_in_tri4<kFma>(m, boxed, lr, int(oi), cull && m.cull, local);
               break;
             }
-            walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+            walk_mesh<true, kFma>(m, boxed, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
               for (std::uint32_t slot = first; slot < first + count; ++slot)
-                if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, cull && m.cull))
-                  consider(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
+                if (auto h = k.hit_pre(lr, m.pre.data() + slot * m.stride, cull && m.cull))
+                  local(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
               return false;
             });
             break;
           }
-          if (opt.accel == Accel::sphere &&
-              !segment_meets_ball(Ray<double>{rd.o, rd.d, double(window.tmin), double(window.tmax)},
-                                  m.bs_center, m.bs_radius + m.pad))
+          if (opt.accel == Accel::sphere && !segment_meets_ball(Ray<double>(lr), m.bs_center, m.bs_radius + m.pad))
             break;
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
-            if (auto h = k.hit_pre(window, m.pre.data() + i * m.stride, cull && m.cull))
-              consider(double(h->t), int(oi), int(i), double(h->b1), double(h->b2));
+            if (auto h = k.hit_pre(lr, m.pre.data() + i * m.stride, cull && m.cull))
+              local(double(h->t), int(oi), int(i), double(h->b1), double(h->b2));
           break;
         }
       }
@@ -650,23 +748,29 @@ struct Tracer::Impl {
     } else {
       for (const int oi : unbounded) visit(std::size_t(oi), false);
       if (const auto& m = soup<T>(); !m.bvh.nodes.empty()) {
+        const double t0 = shift<T>(rd);  // as a mesh's (visit)
+        Ray<T> lr = t0 != 0 ? moved<T>(rd, t0, best.t) : window;
+        auto local = [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
+          consider(t0 + t, obj, prim, b1, b2);
+          lr.tmax = std::min(lr.tmax, T(t));
+        };
         if (!m.tri4.empty()) {
-          const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(window);
-          traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+          const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(lr);
+          traverse<true, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
             moller_simd::Hit4<T> h;
-            moller_simd::hit4<kFma>(lanes, window.tmax, m.tri4[first / 4], false, h);
+            moller_simd::hit4<kFma>(lanes, lr.tmax, m.tri4[first / 4], false, h);
             for (int hits = h.hits; hits; hits &= hits - 1) {
               const int l = __builtin_ctz(unsigned(hits));
-              consider(double(h.t[l]), soup_object[m.bvh.order[first + l]], 0, double(h.b1[l]), double(h.b2[l]));
+              local(double(h.t[l]), soup_object[m.bvh.order[first + l]], 0, double(h.b1[l]), double(h.b2[l]));
             }
             return false;
           }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
         } else {
           const auto& k = tri_method->triangle<T>();
-          traverse<true, kFma>(m.bvh, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+          traverse<true, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
             for (std::uint32_t slot = first; slot < first + count; ++slot)
-              if (auto h = k.hit_pre(window, m.pre.data() + slot * m.stride, false))
-                consider(double(h->t), soup_object[m.bvh.order[slot]], 0, double(h->b1), double(h->b2));
+              if (auto h = k.hit_pre(lr, m.pre.data() + slot * m.stride, false))
+                local(double(h->t), soup_object[m.bvh.order[slot]], 0, double(h->b1), double(h->b2));
             return false;
           });
         }
@@ -764,26 +868,26 @@ struct Tracer::Impl {
               if (h.t >= double(r.tmin) && h.t <= double(r.tmax)) return true;
             break;
           }
+          const Ray<T> lr = moved_any(r);  // as closest_impl's
           if (opt.accel == Accel::bvh) {
             bool hit = false;
             if (!m.tri4.empty()) {
-              hit = any_in_tri4<kFma>(m, boxed, r);
+              hit = any_in_tri4<kFma>(m, boxed, lr);
             } else {
-              walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+              walk_mesh<false, kFma>(m, boxed, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                 for (std::uint32_t slot = first; slot < first + count; ++slot)
-                  if (k.any_pre(r, m.pre.data() + slot * m.stride, false)) return hit = true;
+                  if (k.any_pre(lr, m.pre.data() + slot * m.stride, false)) return hit = true;
                 return false;
               });
             }
             if (hit) return true;
             break;
           }
-          if (opt.accel == Accel::sphere &&
-              !segment_meets_ball(static_cast<Ray<double>>(r), m.bs_center, m.bs_radius + m.pad))
+          if (opt.accel == Accel::sphere && !segment_meets_ball(static_cast<Ray<double>>(lr), m.bs_center, m.bs_radius + m.pad))
             break;
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
-            if (k.any_pre(r, m.pre.data() + i * m.stride, false)) return true;
+            if (k.any_pre(lr, m.pre.data() + i * m.stride, false)) return true;
           break;
         }
       }
@@ -794,18 +898,19 @@ struct Tracer::Impl {
         if (visit(std::size_t(oi), false)) return true;
       bool hit = false;
       if (const auto& m = soup<T>(); !m.bvh.nodes.empty()) {
+        const Ray<T> lr = moved_any(r);  // as a mesh's (visit)
         if (!m.tri4.empty()) {
-          const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(r);
-          traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+          const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(lr);
+          traverse<false, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
             moller_simd::Hit4<T> h;
-            moller_simd::hit4<kFma>(lanes, r.tmax, m.tri4[first / 4], false, h);
+            moller_simd::hit4<kFma>(lanes, lr.tmax, m.tri4[first / 4], false, h);
             return hit = h.hits != 0;
           }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
         } else {
           const auto& k = tri_method->triangle<T>();
-          traverse<false, kFma>(m.bvh, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+          traverse<false, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
             for (std::uint32_t slot = first; slot < first + count; ++slot)
-              if (k.any_pre(r, m.pre.data() + slot * m.stride, false)) return hit = true;
+              if (k.any_pre(lr, m.pre.data() + slot * m.stride, false)) return hit = true;
             return false;
           });
         }

@@ -28,6 +28,7 @@ import numpy as np  # noqa: E402
 from PIL import Image, ImageDraw  # noqa: E402
 
 import peer_subjects  # noqa: E402  (beside this file: peers marked in sections 1 and 2)
+import tracers_report  # noqa: E402  (the whole-tracer section, beside this file)
 
 plt.rcParams.update({
     "svg.fonttype": "none",  # text stays text: smaller and searchable
@@ -821,6 +822,7 @@ def page(rep, charts, methods, uris):
         h.append('<p class="notice">The benchmark has no peer/ rows.</p>')
 
     # ---- 6
+    h.append(tracers_report.html(rep["tracers"], charts["tracers"], esc, chart_html))
     h.append("<h2>6. Images: rayaudit against POV-Ray 3.7</h2>")
     if not rep["images"]:
         h.append('<p class="notice">No comparisons given (<code>--compare DIR</code>).</p>')
@@ -909,6 +911,7 @@ def main():
         "images": images(ctx.get("compare", [])),
         "golden": golden,
         "machine": machine(ctx, audit, bench, stages),
+        "tracers": tracers_report.summary(audit),
     }
     charts = {
         "speed_accuracy": chart_speed_accuracy(rep["speed_accuracy"], methods, bench is not None),
@@ -916,6 +919,7 @@ def main():
         "crack_leaks": chart_crack_leaks(rep["crack_maps"], methods) if rep["crack_maps"] else None,
         "optimisations": chart_optimisations(rep["optimisations"]) if bench else [],
         "peers": chart_peers(rep["peers"]) if bench else None,
+        "tracers": tracers_report.chart(rep["tracers"], svg_of),
     }
     uris = {}
     for c in rep["crack_maps"]:
