@@ -257,8 +257,7 @@ def place_labels(fig, ax, texts, points_px=()):
     first of a fixed ring of offsets where it overlaps no label placed before
     it, nor a marker; deterministic (the points' order). Returns the number
     of overlapping pairs left (0 when every label found room)."""
-    fig.draw_without_rendering()
-    r = fig.canvas.get_renderer()
+    r = _renderer(fig)
     offsets = [(4, 3), (4, -9), (-4, 3), (-4, -9), (8, 10), (8, -16), (-8, 10), (-8, -16), (14, 0), (-14, 0),
                (0, 14), (0, -20), (16, 18), (16, -24), (-16, 18), (-16, -24), (24, 4), (-24, 4)]
     placed = []
@@ -283,9 +282,17 @@ def place_labels(fig, ax, texts, points_px=()):
     return count_overlaps(fig, texts)
 
 
-def count_overlaps(fig, texts):
+def _renderer(fig):
+    """A renderer with the layout applied (the SVG canvas has none of its own)."""
     fig.draw_without_rendering()
-    r = fig.canvas.get_renderer()
+    try:
+        return fig._get_renderer()
+    except AttributeError:
+        return fig.canvas.get_renderer()
+
+
+def count_overlaps(fig, texts):
+    r = _renderer(fig)
     boxes = [t.get_window_extent(r) for t in texts if t.get_visible()]
     return sum(boxes[i].overlaps(boxes[j]) for i in range(len(boxes)) for j in range(i + 1, len(boxes)))
 
