@@ -294,7 +294,7 @@ def _renderer(fig):
 def count_overlaps(fig, texts):
     r = _renderer(fig)
     boxes = [t.get_window_extent(r) for t in texts if t.get_visible()]
-    return sum(boxes[i].overlaps(boxes[j]) for i in range(len(boxes)) for j in range(i + 1, len(boxes)))
+    return int(sum(bool(boxes[i].overlaps(boxes[j])) for i in range(len(boxes)) for j in range(i + 1, len(boxes))))
 
 
 def axis_facts(ax, chart_id, ratio=None, labels=None):
