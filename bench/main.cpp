@@ -3,8 +3,14 @@
 // input, nothing written), then Google Benchmark, whose JSON is kept in
 // memory and written atomically to --json OUT only when every row succeeded.
 //
-//   rayaudit-bench [--quick] [--json OUT] [--threads N] [--filter REGEX] [--benchmark_*...]
+//   rayaudit-bench [--quick] [--json OUT] [--threads N] [--filter REGEX] [--runs N] [--benchmark_*...]
+//
+// Repetitions are rounds: every selected row once per round, so a slow phase
+// of the host spreads over many rows' single repetitions, where it shows as
+// spread, instead of hiding in all repetitions of a few rows (spread.h).
 #include <malloc.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -19,6 +25,8 @@
 #include <random>
 #include <regex>
 #include <set>
+#include <fstream>
+#include <functional>
 #include <sstream>
 
 #include "io/atomic_file.h"
@@ -26,6 +34,7 @@
 #include "bench.h"
 #include "errors.h"
 #include "pov/pov_runner.h"
+#include "spread.h"
 
 // ---- Heap accounting (peak bytes per triangle of the OBJ parsers, bytes of
 // our acceleration structures): every operator new counts its usable size.
@@ -88,6 +97,8 @@ struct Args {
   int threads = 0;
   std::string filter;
   bool has_filter = false;
+  int rounds = 0;  // --benchmark_repetitions (0: the mode's)
+  int runs = 1;    // --runs: separate processes, one after another
   std::vector<std::string> passthrough;  // --benchmark_*
 };
 
@@ -193,14 +204,19 @@ Args parse_args(int argc, char** argv) {
     } else if (option(argc, argv, i, "--filter", v)) {
       a.filter = v;
       a.has_filter = true;
+    } else if (option(argc, argv, i, "--runs", v)) {
+      if (!whole_number(v, 1, 20)) throw ra::InputError("--runs: must be a whole number from 1 to 20, got \"" + v + "\"");
+      a.runs = int(std::strtol(v.c_str(), nullptr, 10));
     } else if (arg.rfind("--benchmark_out", 0) == 0 || arg.rfind("--benchmark_filter", 0) == 0) {
       throw ra::InputError(arg.substr(0, arg.find('=')) + ": use --json OUT and --filter REGEX instead");
     } else if (arg.rfind("--benchmark_", 0) == 0) {
       check_benchmark_flag(arg);
-      a.passthrough.push_back(arg);
+      // Repetitions are run as rounds here (each row once per round).
+      if (arg.rfind("--benchmark_repetitions=", 0) == 0) a.rounds = int(std::strtol(arg.c_str() + 24, nullptr, 10));
+      else a.passthrough.push_back(arg);
     } else {
       throw ra::InputError("rayaudit bench: unknown argument \"" + arg +
-                           "\" (--quick, --json OUT, --threads N, --filter REGEX, --benchmark_*)");
+                           "\" (--quick, --json OUT, --threads N, --filter REGEX, --runs N, --benchmark_*)");
     }
   }
   // Listing runs nothing, so there would be no JSON: replacing OUT with an
@@ -282,11 +298,25 @@ class MemoryJson : public benchmark::BenchmarkReporter {
   benchmark::JSONReporter inner_;
 };
 
-// The console table as usual; remembers whether a row failed.
+// The console table as usual (the context banner once); remembers whether a
+// row failed, and after every row times the calibration workload, so each
+// repetition has the calibration just before and just after it.
 class Reporter : public benchmark::ConsoleReporter {
  public:
   explicit Reporter(OutputOptions options) : ConsoleReporter(options) {}
   bool failed = false;
+  std::function<rb::Calibration(const std::string&)> calibrate;  // times the workload, records the sample
+  struct Seen {
+    std::string name;
+    rb::Calibration before, after;
+  };
+  std::vector<Seen> seen;  // this round's rows, in order
+  rb::Calibration last;
+  bool ReportContext(const Context& c) override {
+    if (context_shown_) return true;
+    context_shown_ = true;
+    return ConsoleReporter::ReportContext(c);
+  }
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs)
       if (r.error_occurred) {
@@ -294,7 +324,16 @@ class Reporter : public benchmark::ConsoleReporter {
         std::fprintf(stderr, "rayaudit bench: %s failed: %s\n", r.benchmark_name().c_str(), r.error_message.c_str());
       }
     ConsoleReporter::ReportRuns(runs);
+    if (calibrate && !runs.empty()) {
+      const std::string name = runs.front().run_name.str();
+      const rb::Calibration after = calibrate(name);
+      seen.push_back({name, last, after});
+      last = after;
+    }
   }
+
+ private:
+  bool context_shown_ = false;
 };
 
 void register_all() {
@@ -307,6 +346,68 @@ void register_all() {
   rb::register_oracle();
 }
 
+
+std::string self_exe(const char* argv0) {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(argv0) : p.string();
+}
+
+// --runs N: this program N times, one process after another, each writing
+// its JSON into a temporary directory; then one JSON over all of them.
+int run_processes(const Args& a, const rb::Mode& mode, const char* argv0) {
+  char tmpl[] = "/tmp/rayaudit-bench-runs-XXXXXX";
+  if (!mkdtemp(tmpl)) throw std::runtime_error("cannot make a temporary directory");
+  struct Cleanup {
+    fs::path p;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(p, ec);
+    }
+  } cleanup{tmpl};
+  const std::string exe = self_exe(argv0);
+  rb::Measured m;
+  for (int i = 0; i < a.runs; ++i) {
+    const fs::path out = fs::path(tmpl) / ("run-" + std::to_string(i) + ".json");
+    std::vector<std::string> args{exe, "--json=" + out.string(), "--benchmark_repetitions=" + std::to_string(mode.rounds)};
+    if (a.quick) args.push_back("--quick");
+    if (a.threads > 0) args.push_back("--threads=" + std::to_string(a.threads));
+    if (a.has_filter) args.push_back("--filter=" + a.filter);
+    args.insert(args.end(), a.passthrough.begin(), a.passthrough.end());
+    std::printf("==== run %d of %d (a separate process) ====\n", i + 1, a.runs);
+    std::fflush(stdout);
+    const pid_t pid = fork();
+    if (pid < 0) throw std::runtime_error("cannot start " + exe);
+    if (pid == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGTERM);  // an interrupted parent takes its run along
+      std::vector<char*> cargv;
+      for (auto& s : args) cargv.push_back(s.data());
+      cargv.push_back(nullptr);
+      execv(exe.c_str(), cargv.data());
+      _exit(127);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      std::fprintf(stderr, "rayaudit bench: run %d of %d failed%s\n", i + 1, a.runs, a.json.empty() ? "" : "; nothing written");
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+    }
+    std::ifstream in(out);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    rb::absorb(rb::parse_gbench(ss.str()), i, m);
+  }
+  // Again over all runs: a run whose calibration was slow as a whole.
+  rb::mark_slow(m.reps, m.cal, mode.rounds * mode.runs);
+  const nlohmann::json all = rb::assemble(m, mode);
+  std::printf("\n%s", rb::summary(all).c_str());
+  if (!a.json.empty()) {
+    ra::write_text_atomically(a.json, all.dump(1) + "\n");
+    std::printf("wrote %s\n", a.json.c_str());
+  }
+  return 0;
+}
+
 int run(int argc, char** argv) {
   const Args a = parse_args(argc, argv);
   rb::config().quick = a.quick;
@@ -316,15 +417,19 @@ int run(int argc, char** argv) {
   // Checked before the run: the directory, the name, and that it is not
   // a corpus file this run reads (note_input above).
   if (!a.json.empty()) ra::declare_output(a.json);
+  const bool listing = lists_tests(a.passthrough);
+  rb::Mode mode;
+  mode.quick = a.quick;
+  mode.rounds = a.rounds > 0 ? a.rounds : rb::repetitions();
+  mode.runs = a.runs;
+  mode.min_time = rb::min_time();
+  mode.filter = a.filter;
+  if (a.runs > 1 && !listing) return run_processes(a, mode, argv[0]);
 
-  std::vector<std::string> gb_args = {argv[0], "--benchmark_repetitions=" + std::to_string(rb::repetitions()),
+  // One repetition per round; the rounds are the repetitions.
+  std::vector<std::string> gb_args = {argv[0], "--benchmark_repetitions=1",
                                       "--benchmark_min_time=" + std::to_string(rb::min_time()),
-                                      "--benchmark_display_aggregates_only=true"};
-  if (a.has_filter) gb_args.push_back("--benchmark_filter=" + a.filter);
-  if (!a.json.empty()) {
-    gb_args.push_back("--benchmark_out=/dev/null");
-    gb_args.push_back("--benchmark_out_format=json");
-  }
+                                      "--benchmark_out=/dev/null", "--benchmark_out_format=json"};
   gb_args.insert(gb_args.end(), a.passthrough.begin(), a.passthrough.end());
   std::vector<char*> gb_argv;
   for (auto& s : gb_args) gb_argv.push_back(s.data());
@@ -346,11 +451,64 @@ int run(int argc, char** argv) {
   // Google Benchmark prints its context banner on the error stream; on
   // stdout, stderr holds only errors (one line for a full disk at the end).
   reporter.SetErrorStream(&std::cout);
-  MemoryJson json;
-  if (a.json.empty())
-    benchmark::RunSpecifiedBenchmarks(&reporter);
-  else
-    benchmark::RunSpecifiedBenchmarks(&reporter, &json);
+  const std::string spec = a.has_filter && !a.filter.empty() ? a.filter : ".";
+  if (listing) {
+    benchmark::RunSpecifiedBenchmarks(&reporter, spec);
+    benchmark::Shutdown();
+    return 0;
+  }
+
+  rb::Measured m;
+  const auto t_start = rb::now();
+  reporter.calibrate = [&](const std::string& after) {
+    const rb::Calibration us = rb::calibration_us();
+    m.cal.push_back({0, rb::seconds_since(t_start), us, after});
+    return us;
+  };
+  // One pass over the rows selected by `filter`; its repetitions join m.
+  auto round = [&](int index, const std::string& filter, bool retry) {
+    reporter.seen.clear();
+    reporter.last = reporter.calibrate("");
+    MemoryJson json;
+    benchmark::RunSpecifiedBenchmarks(&reporter, &json, filter);
+    const nlohmann::json j = rb::parse_gbench(json.text());
+    if (m.context.is_null()) m.context = j.at("context");
+    std::size_t k = 0;
+    for (const auto& b : j.at("benchmarks")) {
+      if (b.value("run_type", "") != "iteration") continue;
+      rb::Rep r;
+      r.row = b;
+      r.round = index;
+      r.retry = retry;
+      const std::string name = b.value("run_name", b.value("name", std::string()));
+      // The reporter saw the same rows in the same order.
+      while (k < reporter.seen.size() && reporter.seen[k].name != name) ++k;
+      if (k < reporter.seen.size()) {
+        r.cal_before = reporter.seen[k].before;
+        r.cal_after = reporter.seen[k].after;
+        ++k;
+      }
+      m.reps.push_back(std::move(r));
+    }
+  };
+  for (int i = 0; i < mode.rounds; ++i) {
+    if (mode.rounds > 1) std::printf("---- repetition %d of %d (every row once) ----\n", i + 1, mode.rounds);
+    std::fflush(stdout);
+    round(i, spec, false);
+    if (reporter.failed) break;
+  }
+  // Repetitions beside a slow calibration are run again (twice at most),
+  // unless most of more than 8 rows would be: then the whole run is slow, and says so.
+  std::set<std::string> all_rows;
+  for (const auto& r : m.reps) all_rows.insert(r.row.value("run_name", std::string()));
+  for (int pass = 0; !reporter.failed && pass < 2; ++pass) {
+    const std::vector<std::string> again = rb::mark_slow(m.reps, m.cal, mode.rounds);
+    if (again.empty() || (2 * again.size() > all_rows.size() && again.size() > 8)) break;
+    std::printf("---- again: %zu row(s) had a repetition beside a slow calibration ----\n", again.size());
+    std::fflush(stdout);
+    round(mode.rounds + pass, rb::exact_names_regex(again), true);
+  }
+  rb::mark_slow(m.reps, m.cal, mode.rounds);
   benchmark::Shutdown();
   if (!rb::notes().empty()) {
     std::printf("\n");
@@ -360,8 +518,10 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "rayaudit bench: some rows failed%s\n", a.json.empty() ? "" : "; nothing written");
     return 1;
   }
+  const nlohmann::json all = rb::assemble(m, mode);
+  std::printf("\n%s", rb::summary(all).c_str());
   if (!a.json.empty()) {
-    ra::write_text_atomically(a.json, json.text());
+    ra::write_text_atomically(a.json, all.dump(1) + "\n");
     std::printf("wrote %s\n", a.json.c_str());
   }
   return 0;

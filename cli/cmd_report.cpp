@@ -26,8 +26,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 struct Args {
-  std::string audit, bench, crack_maps, golden, stages, out;
-  std::vector<std::string> compare;
+  std::string audit, crack_maps, golden, stages, out;
+  std::vector<std::string> compare, bench;
 };
 
 // Debian's matplotlib is installed for the system interpreter only.
@@ -278,8 +278,12 @@ void run(const Args& a) {
     throw ra::InputError(a.out + ": its parent directory does not exist");
   if (!fs::exists(dir) && ::access(fs::absolute(dir).parent_path().c_str(), W_OK) != 0)
     throw ra::InputError(ra::located(a.out, 0, std::string("cannot create the directory: ") + std::strerror(errno)));
-  check_audit(a.audit);
-  if (!a.bench.empty()) check_bench(a.bench);
+  // Either alone makes a page: the audit's correctness, or (a
+  // performance-only report) the benchmarks'.
+  if (a.audit.empty() && a.bench.empty())
+    throw ra::InputError("rayaudit report: needs --audit FILE, --bench FILE, or both");
+  if (!a.audit.empty()) check_audit(a.audit);
+  for (const auto& b : a.bench) check_bench(b);
   for (const auto& d : a.compare) check_compare_dir(d);
   if (!a.crack_maps.empty()) check_crack_maps(a.crack_maps);
   if (!a.golden.empty()) check_golden(a.golden);
@@ -304,8 +308,10 @@ void run(const Args& a) {
   } cleanup{tmp};
   json compare = json::array();
   for (const auto& d : a.compare) compare.push_back(absolute(d));
-  json ctx = {{"audit", absolute(a.audit)},
-                    {"bench", a.bench.empty() ? json(nullptr) : json(absolute(a.bench))},
+  json benches = json::array();
+  for (const auto& b : a.bench) benches.push_back(absolute(b));
+  json ctx = {{"audit", a.audit.empty() ? json(nullptr) : json(absolute(a.audit))},
+                    {"bench", benches},
                     {"compare", compare},
                     {"crack_maps", a.crack_maps.empty() ? json(nullptr) : json(absolute(a.crack_maps))},
                     {"golden", a.golden.empty() ? json(nullptr) : json(absolute(a.golden))},
@@ -322,15 +328,17 @@ void run(const Args& a) {
   // of their bytes, which the script decodes with os.fsdecode (HOSTILE2 F31:
   // a Latin-1 directory name could not be opened from the context).
   json fs_paths = json::object();
-  for (const char* k : {"audit", "bench", "crack_maps", "golden", "stages", "out_dir"})
+  for (const char* k : {"audit", "crack_maps", "golden", "stages", "out_dir"})
     if (ctx.at(k).is_string()) fs_paths[k] = hex_bytes(k == std::string("out_dir") ? tmp.string() :
                                                       k == std::string("audit") ? absolute(a.audit) :
-                                                      k == std::string("bench") ? absolute(a.bench) :
                                                       k == std::string("crack_maps") ? absolute(a.crack_maps) :
                                                       k == std::string("golden") ? absolute(a.golden) : absolute(a.stages));
   json cmp_hex = json::array();
   for (const auto& d : a.compare) cmp_hex.push_back(hex_bytes(absolute(d)));
   fs_paths["compare"] = cmp_hex;
+  json bench_hex = json::array();
+  for (const auto& b : a.bench) bench_hex.push_back(hex_bytes(absolute(b)));
+  fs_paths["bench"] = bench_hex;
   ctx["fs_paths"] = fs_paths;
   std::ofstream(tmp / "context.json") << ctx.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
   const int rc = run_script(tmp / "context.json");
@@ -366,8 +374,10 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand("report",
                                  "One self-contained HTML page (and report.json) from earlier outputs: speed against "
                                  "accuracy, stability, crack maps, optimisations, peers, images");
-  cmd->add_option("--audit", a->audit, "rayaudit audit --json output")->required();
-  cmd->add_option("--bench", a->bench, "rayaudit bench --json output (Google Benchmark JSON)");
+  cmd->add_option("--audit", a->audit, "rayaudit audit --json output (without it: a performance-only report)");
+  cmd->add_option("--bench", a->bench,
+                  "rayaudit bench --json output (repeatable: several runs are combined, each row the median of "
+                  "their medians, runs whose calibration was slow left out and named)");
   cmd->add_option("--compare", a->compare,
                   "Directory of rayaudit compare --json outputs, with NAME-ours.png, NAME-pov.png, NAME-diff.png "
                   "beside them (repeatable)");

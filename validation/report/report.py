@@ -27,6 +27,7 @@ import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402
 from PIL import Image, ImageDraw  # noqa: E402
 
+import perf  # noqa: E402  (the performance parts: spread, machine, drawing rules)
 import peer_subjects  # noqa: E402  (beside this file: peers marked in sections 1 and 2)
 import tracers_report  # noqa: E402  (the whole-tracer section, beside this file)
 
@@ -63,6 +64,11 @@ def load_json(path):
     with open(path, encoding="utf-8-sig") as f:
         return json.load(f)
 ZERO_FLOOR = 1e-5  # where "0 %" is drawn on a log axis
+
+# The run's mode, repetitions and machine, stamped on every performance chart
+# (set by main), and what each chart's axes show (written to report.json).
+STAMP = [""]
+CHART_FACTS = []
 
 # ------------------------------------------------------------------ helpers --
 
@@ -163,17 +169,9 @@ class Methods:
 
 
 def bench_rows(bench):
-    """name -> row, preferring the median aggregate over single iterations."""
-    rows = {}
-    for b in (bench or {}).get("benchmarks", []):
-        name = b.get("run_name") or b["name"]
-        if b.get("run_type") == "aggregate":
-            if b.get("aggregate_name") != "median":
-                continue
-            rows[name] = b
-        elif name not in rows or rows[name].get("run_type") != "aggregate":
-            rows.setdefault(name, b)
-    return rows
+    """name -> row: each figure the median over the runs (perf.combine), its
+    spread under "_spread"."""
+    return (bench or {}).get("rows", {})
 
 
 def parse_bench_name(name):
@@ -200,7 +198,7 @@ def speed_accuracy(audit, bench, methods):
         parts, keys = parse_bench_name(name)
         if parts[:1] == ["kernel"] and len(parts) >= 4 and parts[3] == "nocull" \
                 and keys.get("hit") == "50" and keys.get("back", "0") == "0" and "ns_per_test" in b:
-            ns[(parts[1], parts[2])] = float(b["ns_per_test"])
+            ns[(parts[1], parts[2])] = (float(b["ns_per_test"]), b["_spread"].get("ns_per_test"), b["_flagged"])
     out = []
     for s in audit["subjects"]:
         t = s["totals"]
@@ -211,7 +209,9 @@ def speed_accuracy(audit, bench, methods):
             "precision": s["precision"],
             "kind": s["kind"],
             "document_variant": methods.is_document(s["method"]),
-            "ns_per_test": ns.get((s["method"], s["precision"])),
+            "ns_per_test": ns.get((s["method"], s["precision"]), (None,))[0],
+            "ns_spread": ns.get((s["method"], s["precision"]), (None, None))[1],
+            "ns_flagged": ns.get((s["method"], s["precision"]), (None, None, ""))[2],
             "wrong_pct": t["wrong_pct"],
             "leaks": t.get("leaks", 0),
             "groups": groups,
@@ -233,14 +233,20 @@ def pareto(points):
 
 def scatter_panel(ax, entries, methods, yfield, ylabel, title):
     pts = [(e["ns_per_test"], max(e[yfield], ZERO_FLOOR)) for e in entries]
+    labels = []
     for e, (x, y) in zip(entries, pts):
         doc = e["document_variant"]
         c = methods.colour.get(e["method"], "k")
+        sp = e.get("ns_spread")
+        if sp:  # thin: min-max over repetitions and runs; thick: the quartiles
+            ax.errorbar([x], [y], xerr=[[x - sp["min"]], [sp["max"] - x]], fmt="none", ecolor=c, lw=0.7, alpha=0.6)
+            ax.errorbar([x], [y], xerr=[[x - sp["q1"]], [sp["q3"] - x]], fmt="none", ecolor=c, lw=2.2, alpha=0.8)
         ax.scatter([x], [y], s=60, marker="*" if e.get("peer") else "o" if e["precision"] == "float" else "s",
                    facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=3)
-        ax.annotate(("doc: " if doc else "peer: " if e.get("peer") else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d"),
-                    (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6.5,
-                    color=c, alpha=0.9)
+        labels.append(ax.annotate(("doc: " if doc else "peer: " if e.get("peer") else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d")
+                                  + (" (!)" if e.get("ns_flagged") else ""),
+                                  (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6.5,
+                                  color=c, alpha=0.9))
     front = pareto(pts)
     if len(front) > 1:
         ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, alpha=0.6,
@@ -256,10 +262,12 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
     if any(e[yfield] == 0 for e in entries):  # zeros sit on a floor line, labelled
         ax.axhline(ZERO_FLOOR, color="g", lw=0.8, alpha=0.6)
         ax.text(ax.get_xlim()[0], ZERO_FLOOR, " 0 (none found)", color="g", fontsize=7, va="bottom")
-    ax.set_xlabel("ns per ray/triangle test (log; kernel bench, 50% hits; left is faster)")
+    ax.set_xlabel("ns per ray/triangle test (log; kernel bench, 50% hits, 4096 pairs a row; left is faster;\n"
+                  "thick bar: quartiles, thin: min-max over repetitions and runs; (!) flagged)")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=7, frameon=False)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=7, frameon=False)
+    return labels
 
 
 def chart_speed_accuracy(entries, methods, have_bench):
@@ -270,24 +278,29 @@ def chart_speed_accuracy(entries, methods, have_bench):
         timed_tri = [e for e in tri if e["ns_per_test"] is not None]
         timed_sph = [e for e in sph if e["ns_per_test"] is not None]
         if timed_tri:
-            fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
-            scatter_panel(axes[0], timed_tri, methods, "wrong_pct", "wrong % of tests (log; down is righter)",
-                          "Triangle methods: speed against wrong answers")
+            fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+            labels0 = scatter_panel(axes[0], timed_tri, methods, "wrong_pct", "wrong % of tests (log; down is righter)",
+                                    "Triangle methods: speed against wrong answers")
             leak = [e for e in timed_tri if e["leaks_per_million"] is not None]
             for e in leak:
                 e["_lpm"] = e["leaks_per_million"]
-            scatter_panel(axes[1], [dict(e, wrong_pct=e["_lpm"]) for e in leak], methods, "wrong_pct",
-                          "watertight leaks per million group rays (log)", "Triangle methods: speed against leaks")
+            labels1 = scatter_panel(axes[1], [dict(e, wrong_pct=e["_lpm"]) for e in leak], methods, "wrong_pct",
+                                    "watertight leaks per million group rays (log)", "Triangle methods: speed against leaks")
             for e in leak:
                 del e["_lpm"]
+            perf.stamp(fig, STAMP[0])
+            for ax, labs, n in ((axes[0], labels0, "speed_wrong"), (axes[1], labels1, "speed_leaks")):
+                CHART_FACTS.append(perf.axis_facts(ax, n, labels=perf.place_labels(fig, ax, labs)))
             charts.append((svg_of(fig), "Each point is a method x precision (circle float, square double, hollow = "
                            "a seed document's method as written). Down-left is better: the dashed line joins the "
                            "methods nothing else beats on both speed and correctness." +
                            (peer_subjects.CAPTION if any(e.get("peer") for e in timed_tri) else "")))
         if timed_sph:
-            fig, ax = plt.subplots(figsize=(6, 4.2))
-            scatter_panel(ax, timed_sph, methods, "wrong_pct", "wrong % of tests (log)",
-                          "Sphere methods: speed against wrong answers")
+            fig, ax = plt.subplots(figsize=(6, 4.4))
+            labs = scatter_panel(ax, timed_sph, methods, "wrong_pct", "wrong % of tests (log)",
+                                 "Sphere methods: speed against wrong answers")
+            perf.stamp(fig, STAMP[0])
+            CHART_FACTS.append(perf.axis_facts(ax, "speed_wrong_spheres", labels=perf.place_labels(fig, ax, labs)))
             charts.append((svg_of(fig), "Sphere methods over the sphere families (huge, tiny-far, near-origin); "
                            "same reading as above."))
     else:
@@ -459,23 +472,35 @@ def optimisations(bench):
         scene.append({"name": name, "mesh": parts[1], "accel": parts[2], "cull": parts[3] == "cull",
                       "rays": parts[4], "threads": keys.get("threads", "1"),
                       "triangles": b.get("triangles"), "Mrays_per_s": float(b["Mrays_per_s"]),
+                      "Mrays_spread": b["_spread"].get("Mrays_per_s"), "rays_traced": b.get("rays"),
+                      "flagged": b["_flagged"],
                       "build_s": b.get("build_s"), "bytes_per_triangle": b.get("bytes_per_triangle")})
     index = {(r["mesh"], r["accel"], r["cull"], r["rays"], r["threads"]): r for r in scene}
     one = min((r["threads"] for r in scene), key=lambda t: int(t) if t.isdigit() else 1e9, default="1")
     speedups = []
+
+    def speedup(r, base, what):
+        # The spread of a ratio of medians: the quartiles crossed (the
+        # optimised row's lower quartile over the base's upper, and back).
+        sa, sb = r["Mrays_spread"], base["Mrays_spread"]
+        lo_hi = (sa["q1"] / sb["q3"], sa["q3"] / sb["q1"]) if sa and sb and sb["q1"] > 0 else None
+        speedups.append({"mesh": r["mesh"], "triangles": r["triangles"], "rays": r["rays"], "what": what,
+                         "speedup": r["Mrays_per_s"] / base["Mrays_per_s"], "spread": lo_hi,
+                         "rays_traced": r["rays_traced"], "flagged": "; ".join(x for x in (r["flagged"], base["flagged"]) if x)})
+
     for r in scene:
         if r["threads"] != one:
             continue
         if r["accel"] in ("sphere", "bvh") and not r["cull"]:
             base = index.get((r["mesh"], "none", False, r["rays"], r["threads"]))
             if base and base["Mrays_per_s"] > 0:
-                speedups.append({"mesh": r["mesh"], "triangles": r["triangles"], "rays": r["rays"],
-                                 "what": f"{r['accel']} over none", "speedup": r["Mrays_per_s"] / base["Mrays_per_s"]})
-        if r["cull"]:
+                speedup(r, base, f"{r['accel']} over none")
+        # Shadow rays are any-hit tests that ignore facing: culling changes
+        # no work there, so their ratio is noise and is not charted.
+        if r["cull"] and r["rays"] != "shadow":
             base = index.get((r["mesh"], r["accel"], False, r["rays"], r["threads"]))
             if base and base["Mrays_per_s"] > 0:
-                speedups.append({"mesh": r["mesh"], "triangles": r["triangles"], "rays": r["rays"],
-                                 "what": f"culling ({r['accel']})", "speedup": r["Mrays_per_s"] / base["Mrays_per_s"]})
+                speedup(r, base, f"culling ({r['accel']})")
     scaling = []
     for accel in dict.fromkeys(r["accel"] for r in scene):
         rs = sorted((r for r in scene if r["accel"] == accel and not r["cull"] and r["rays"] == "primary"
@@ -485,9 +510,47 @@ def optimisations(bench):
         n = np.array([float(r["triangles"]) for r in rs])
         ns = np.array([1e3 / r["Mrays_per_s"] for r in rs])
         slope = float(np.polyfit(np.log10(n), np.log10(ns), 1)[0]) if len(rs) >= 2 else None
+        # ns per ray is 1000 / Mrays per s: the rate's upper quartile is the time's lower.
+        q = [(1e3 / r["Mrays_spread"]["q3"], 1e3 / r["Mrays_spread"]["q1"]) if r["Mrays_spread"] else None for r in rs]
         scaling.append({"accel": accel, "triangles": n.tolist(), "ns_per_ray": ns.tolist(), "slope": slope,
-                        "meshes": [r["mesh"] for r in rs]})
+                        "ns_quartiles": q, "meshes": [r["mesh"] for r in rs]})
     return {"threads": one, "scene_rows": scene, "speedups": speedups, "scaling": scaling}
+
+
+def ratio_bars(ax, labels, vals, spreads, colour, vertical=True, width=0.8, offset=0.0, label=None):
+    """Bars from 1x to each ratio with their spread as error bars and the
+    ratio written past the bar's end; returns the values the axis must hold
+    and the text labels."""
+    pos = np.arange(len(labels)) + offset
+    base = [min(v, 1.0) for v in vals]
+    size = [abs(v - 1.0) for v in vals]
+    if vertical:
+        ax.bar(pos, size, width, bottom=base, color=colour, label=label)
+    else:
+        ax.barh(pos, size, width, left=base, color=colour, label=label)
+    held, texts = list(vals), []
+    for p, v, sp in zip(pos, vals, spreads):
+        if not (v == v):
+            continue
+        end = v
+        if sp:
+            err = [[max(v - sp[0], 0)], [max(sp[1] - v, 0)]]
+            if vertical:
+                ax.errorbar([p], [v], yerr=err, fmt="none", ecolor="k", lw=0.9, capsize=2)
+            else:
+                ax.errorbar([v], [p], xerr=err, fmt="none", ecolor="k", lw=0.9, capsize=2)
+            held += list(sp)
+            end = sp[1] if v >= 1 else sp[0]
+        up = v >= 1
+        if vertical:
+            texts.append(ax.annotate(perf.ratio_text(v), (p, end), textcoords="offset points",
+                                     xytext=(0, 2 if up else -2), ha="center", va="bottom" if up else "top",
+                                     fontsize=6.5))
+        else:
+            texts.append(ax.annotate(perf.ratio_text(v), (end, p), textcoords="offset points",
+                                     xytext=(3 if up else -3, 0), ha="left" if up else "right", va="center",
+                                     fontsize=6.5))
+    return held, texts
 
 
 def chart_optimisations(opt):
@@ -498,41 +561,59 @@ def chart_optimisations(opt):
         groups = [("accelerator over none", [w for w in dict.fromkeys(s["what"] for s in sp) if "over none" in w]),
                   ("backface culling", [w for w in dict.fromkeys(s["what"] for s in sp) if w.startswith("culling")])]
         groups = [g for g in groups if g[1]]
-        fig, axes = plt.subplots(len(groups), len(raykinds), figsize=(6 * len(raykinds), 3.2 * len(groups)),
-                                 squeeze=False)
-        for gi, (gname, whats) in enumerate(groups):
-            for ax, rk in zip(axes[gi], raykinds):
-                meshes = sorted(dict.fromkeys(s["mesh"] for s in sp if s["rays"] == rk and s["what"] in whats),
-                                key=lambda m: next(s["triangles"] or 0 for s in sp if s["mesh"] == m))
-                w = 0.8 / max(1, len(whats))
-                for k, what in enumerate(whats):
-                    vals = [next((s["speedup"] for s in sp if s["mesh"] == m and s["what"] == what and s["rays"] == rk),
-                                 np.nan) for m in meshes]
-                    bars = ax.bar(np.arange(len(meshes)) + k * w, vals, w, label=what)
-                    ax.bar_label(bars, labels=[f"{v:.2g}x" if v == v else "" for v in vals], fontsize=6.5)
-                ax.axhline(1, color="k", lw=0.8)
-                ax.set_yscale("log")
-                times = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:.3g}x")
-                ax.yaxis.set_major_formatter(times)
-                ax.yaxis.set_minor_formatter(times)
-                ax.tick_params(axis="y", which="minor", labelsize=6.5)
-                ax.set_xticks(np.arange(len(meshes)) + w * (len(whats) - 1) / 2, meshes, rotation=15, fontsize=7)
-                ax.set_ylabel("speed-up (x, log)")
-                ax.set_title(f"{gname}: {rk} rays, {opt['threads']} thread(s)")
-                ax.legend(fontsize=7)
+        panels = [(g, rk) for g in groups for rk in raykinds
+                  if any(s["rays"] == rk and s["what"] in g[1] for s in sp)]
+        fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 3.6), squeeze=False)
+        cmap = plt.get_cmap("tab10")
+        for ax, ((gname, whats), rk) in zip(axes[0], panels):
+            meshes = sorted(dict.fromkeys(s["mesh"] for s in sp if s["rays"] == rk and s["what"] in whats),
+                            key=lambda m: next(s["triangles"] or 0 for s in sp if s["mesh"] == m))
+            w = 0.8 / max(1, len(whats))
+            held, texts = [], []
+            for k, what in enumerate(whats):
+                found = [next((s for s in sp if s["mesh"] == m and s["what"] == what and s["rays"] == rk), None)
+                         for m in meshes]
+                vals = [s["speedup"] if s else np.nan for s in found]
+                spreads = [s["spread"] if s else None for s in found]
+                h, t = ratio_bars(ax, meshes, vals, spreads, cmap(k % 10), width=w, offset=k * w - 0.4 + w / 2,
+                                  label=what)
+                held += h
+                texts += t
+            lim = perf.ratio_axis(ax, held, axis="y")
+            ax.set_xticks(np.arange(len(meshes)), meshes, rotation=15, fontsize=7)
+            ax.set_xlim(-0.6, len(meshes) - 0.4)
+            ax.set_ylabel("speed-up (x, log; 1x: no change)")
+            rays = sorted({s["rays_traced"] for s in sp if s["rays"] == rk and s["what"] in whats and s["rays_traced"]})
+            ax.set_title(f"{gname}: {rk} rays, {opt['threads']} thread(s)\n"
+                         f"{'/'.join(f'{int(r):,}' for r in rays) if rays else '?'} rays a pass", fontsize=8.5)
+            ax.legend(fontsize=7, loc="lower left")
+            CHART_FACTS.append(perf.axis_facts(ax, f"optimisations/{gname}/{rk}", ratio={"axis": "y", "limits": lim,
+                                                                                          "bars_from": 1.0},
+                                               labels=perf.count_overlaps(fig, texts)))
+        perf.stamp(fig, STAMP[0])
         charts.append((svg_of(fig), "Each bar is rays per second with the optimisation divided by without it, "
-                       "per rung of the mesh ladder (smallest left): above the line it pays, below it costs."))
+                       "per rung of the mesh ladder (smallest left), drawn from 1x: up, it pays; down, it costs. "
+                       "Error bars: the optimised row's quartiles over the base row's (low: its lower quartile over "
+                       "the base's upper). Culling is charted for primary rays only: shadow rays are any-hit tests "
+                       "that ignore facing, so culling does the same work there."))
     if opt["scaling"]:
         fig, ax = plt.subplots(figsize=(6.5, 4))
         for s in opt["scaling"]:
             lab = s["accel"] + (f" (slope {s['slope']:.2f})" if s["slope"] is not None else "")
-            ax.plot(s["triangles"], s["ns_per_ray"], marker="o", label=lab)
+            q = s.get("ns_quartiles") or []
+            err = None
+            if q and all(q):
+                err = [[max(y - lo, 0) for y, (lo, _) in zip(s["ns_per_ray"], q)],
+                       [max(hi - y, 0) for y, (_, hi) in zip(s["ns_per_ray"], q)]]
+            ax.errorbar(s["triangles"], s["ns_per_ray"], yerr=err, marker="o", capsize=2, label=lab)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("triangles in the mesh (log)")
-        ax.set_ylabel("ns per primary ray (log)")
+        ax.set_ylabel("ns per primary ray (log; bars: quartiles)")
         ax.set_title("Cost per ray against mesh size")
         ax.legend(fontsize=7)
+        perf.stamp(fig, STAMP[0])
+        CHART_FACTS.append(perf.axis_facts(ax, "scaling"))
         charts.append((svg_of(fig), "Slope 1 means the cost grows with the triangle count (every triangle "
                        "tested); near 0 means it barely grows (a BVH should be logarithmic)."))
     return charts
@@ -546,30 +627,37 @@ def peers(bench):
     for name, b in bench_rows(bench).items():
         parts, _ = parse_bench_name(name)
         if parts[:1] == ["peer"] and len(parts) >= 2 and "ratio" in b:
-            out.append({"name": name, "peer": parts[1], "ratio": float(b["ratio"])})
+            sp = b["_spread"].get("ratio")
+            out.append({"name": name, "peer": parts[1], "ratio": float(b["ratio"]),
+                        "spread": (sp["q1"], sp["q3"]) if sp else None,
+                        "range": (sp["min"], sp["max"]) if sp else None, "rays": b.get("rays"),
+                        "flagged": b["_flagged"]})
     return out
 
 
 def chart_peers(ps):
     if not ps:
         return None
-    fig, ax = plt.subplots(figsize=(8, 0.3 * len(ps) + 1.2))
+    fig, ax = plt.subplots(figsize=(8, 0.3 * len(ps) + 1.6))
     cmap = plt.get_cmap("tab10")
     names = list(dict.fromkeys(p["peer"] for p in ps))
-    ys = range(len(ps))
-    ax.barh(list(ys), [p["ratio"] for p in ps], color=[cmap(names.index(p["peer"]) % 10) for p in ps])
-    ax.set_yticks(list(ys), [re.sub(r"^peer/", "", p["name"]) for p in ps], fontsize=6.5)
-    ax.axvline(1, color="k", lw=0.8)
-    ax.set_xscale("log")
-    ticks = [t for t in (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100)
-             if min(p["ratio"] for p in ps) / 2 <= t <= max(p["ratio"] for p in ps) * 2]
-    ax.set_xticks(ticks, [f"{t:g}x" for t in ticks])
-    ax.minorticks_off()
-    for y, p in zip(ys, ps):
-        ax.text(p["ratio"], y, f" {p['ratio']:.2g}x", va="center", fontsize=6.5)
-    ax.invert_yaxis()
-    ax.set_xlabel("rayaudit's rate / the peer's (log): right of 1, rayaudit is faster; left, the peer")
+    ys = np.arange(len(ps))
+    held, texts = [], []
+    for i, p in enumerate(ps):
+        h, t = ratio_bars(ax, [p["name"]], [p["ratio"]], [p["spread"]], cmap(names.index(p["peer"]) % 10),
+                          vertical=False, offset=i)
+        held += h
+        texts += t
+    ax.set_yticks(list(ys), [re.sub(r"^peer/", "", p["name"]) + (" (!)" if p["flagged"] else "") for p in ps],
+                  fontsize=6.5)
+    lim = perf.ratio_axis(ax, held, axis="x")
+    ax.set_ylim(len(ps) - 0.5, -0.5)
+    ax.set_xlabel("rayaudit's rate / the peer's (log, bars from 1x): right, rayaudit is faster; left, the peer\n"
+                  "error bars: quartiles of the per-repetition ratios (each measured back to back); (!) flagged")
     ax.set_title("rayaudit against its peers, same rays, same run")
+    perf.stamp(fig, STAMP[0])
+    CHART_FACTS.append(perf.axis_facts(ax, "peers", ratio={"axis": "x", "limits": lim, "bars_from": 1.0},
+                                       labels=perf.count_overlaps(fig, texts)))
     return svg_of(fig)
 
 
@@ -634,10 +722,18 @@ def machine(ctx, audit, bench, stages):
     src = ctx.get("source_dir", "")
     commit = run(["git", "-C", src, "rev-parse", "--short=12", "HEAD"]) if src else ""
     dirty = run(["git", "-C", src, "status", "--porcelain", "--untracked-files=no"]) if src else ""
-    ctxb = (bench or {}).get("context", {})
+    ctxb = bench["runs"][0]["context"] if bench else {}
+    here = perf.local_machine()
+    bm = next((r["machine"] for r in (bench or {}).get("runs", []) if r.get("machine")), None) or here
+    steal = [r["steal_pct"] for r in (bench or {}).get("runs", []) if r.get("steal_pct") is not None]
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
+        "bench_machine": bm,
+        "machine_line": ("benchmarks ran on: " if bench else "") +
+                        perf.machine_line(bm, max(steal) if steal else None) +
+                        ("" if not bench or bm.get("cpu_model") == here.get("cpu_model") else
+                         "; this page was drawn on: " + perf.machine_line(here)),
         "bench_context": {k: ctxb[k] for k in ("host_name", "num_cpus", "mhz_per_cpu", "library_build_type", "date")
                           if k in ctxb},
         "compiler": ctx["build"]["compiler"],
@@ -647,8 +743,8 @@ def machine(ctx, audit, bench, stages):
         "commit": (commit + (" (with uncommitted changes)" if dirty else "")) or "unknown",
         "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         "versions": versions,
-        "seed": audit.get("seed"),
-        "rays_per_family": audit.get("rays_per_family"),
+        "seed": (audit or {}).get("seed"),
+        "rays_per_family": (audit or {}).get("rays_per_family"),
         "stages": stages,
     }
 
@@ -693,6 +789,36 @@ window.addEventListener('load', function () {
 """
 
 
+def perf_facts(rep):
+    """The headlines about speed and rightness, each with its rule, so that
+    they agree with the tables below them."""
+    facts = []
+    sa = [e for e in rep["speed_accuracy"] if e["kind"] == "triangle"]
+    timed = [e for e in sa if e["ns_per_test"] is not None]
+    if timed:
+        f = min(timed, key=lambda e: e["ns_per_test"])
+        sp = f.get("ns_spread")
+        spread = f", quartiles {fnum(sp['q1'])}-{fnum(sp['q3'])}" if sp else ""
+        # Others whose quartiles reach the winner's: not told apart by this run.
+        ties = [e for e in timed if e is not f and e.get("ns_spread") and sp and e["ns_spread"]["q1"] <= sp["q3"]]
+        tie = (f"; not told apart from {', '.join(esc(e['subject']) for e in ties)} (quartiles overlap)"
+               if ties else "")
+        facts.append(f"Fastest triangle test (lowest median ns per test, kernel bench at 50% hits, no culling; "
+                     f"{esc(STAMP[0])}): <b>{esc(f['subject'])}</b> at {fnum(f['ns_per_test'])} ns{spread}"
+                     f" ({fnum(f['wrong_pct'])}% wrong){tie}" + (" <span class=\"warn\">flagged</span>"
+                                                                 if f.get("ns_flagged") else ""))
+    if sa:
+        right = min(sa, key=lambda e: (e["leaks"] > 0, e["wrong_pct"], e["ns_per_test"] or 0))
+        fewer = [e for e in sa if e["wrong_pct"] < right["wrong_pct"]]
+        rule = ("rule: leak-free methods first, then the fewest wrong answers, then the fastest"
+                if any(e["leaks"] == 0 for e in sa) else "rule: the fewest wrong answers (every method leaks)")
+        below = ("; ranked below it for leaking: " + ", ".join(
+            f"{esc(e['subject'])} ({fnum(e['wrong_pct'])}% wrong, {e['leaks']:,} leaks)" for e in fewer)) if fewer else ""
+        facts.append(f"Most right ({rule}): <b>{esc(right['subject'])}</b> ({fnum(right['wrong_pct'])}% wrong, "
+                     f"{right['leaks']:,} leaks){below}")
+    return facts
+
+
 def chart_html(svg, caption):
     return f'<div class="chart">{svg}</div><p class="cap">{esc(caption)}</p>'
 
@@ -706,15 +832,8 @@ def page(rep, charts, methods, uris):
     # ---- key facts: what a newcomer wants first.
     sa = [e for e in rep["speed_accuracy"] if e["kind"] == "triangle"]
     facts = []
-    timed = [e for e in sa if e["ns_per_test"] is not None]
-    if timed:
-        f = min(timed, key=lambda e: e["ns_per_test"])
-        facts.append(f"Fastest triangle test: <b>{esc(f['subject'])}</b> at {fnum(f['ns_per_test'])} ns "
-                     f"({fnum(f['wrong_pct'])}% wrong)")
+    facts += perf_facts(rep)
     if sa:
-        right = min(sa, key=lambda e: (e["leaks"] > 0, e["wrong_pct"], e["ns_per_test"] or 0))
-        facts.append(f"Most right: <b>{esc(right['subject'])}</b> ({fnum(right['wrong_pct'])}% wrong, "
-                     f"{right['leaks']} leaks)")
         leakfree = [e["subject"] for e in sa if e["leaks"] == 0]
         facts.append("Leak-free (no ray through a closed group): " +
                      (", ".join(f"<b>{esc(s)}</b>" for s in leakfree) if leakfree else "<b>none</b>"))
@@ -728,11 +847,15 @@ def page(rep, charts, methods, uris):
     # ---- 7 header (first on the page: what the figures rest on).
     h.append("<h2>The run</h2>")
     h.append('<p class="cap">What these figures were measured on; every ratio below is from this one run.</p><dl class="hdr">')
-    rows = [("CPU", f"{m['cpu']} ({m['cores']} cores)"), ("Compiler", m["compiler"]),
+    rows = [("Machine", m["machine_line"]), ("Compiler", m["compiler"]),
             ("Flags", f"{m['flags']} ({m['build_type']})"), ("rayaudit", f"{m['rayaudit']}, commit {m['commit']}"),
             ("Date", m["date"]),
-            ("Libraries", ", ".join(f"{k} {v}" for k, v in m["versions"].items())),
-            ("Audit", f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method x precision")]
+            ("Libraries", ", ".join(f"{k} {v}" for k, v in m["versions"].items()))]
+    if rep["have_audit"]:
+        rows.append(("Audit", f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method "
+                              "x precision"))
+    if rep["have_bench"]:
+        rows.append(("Benchmark runs", f"{len(rep['bench_runs'])} JSON(s): {STAMP[0]}"))
     if m["bench_context"]:
         names = {"host_name": "host", "num_cpus": "CPUs", "mhz_per_cpu": "MHz",
                  "library_build_type": "Google Benchmark library built as", "date": "run at"}
@@ -744,12 +867,29 @@ def page(rep, charts, methods, uris):
     h.append("</dl>")
 
     # ---- 1
+    if rep["have_bench"]:
+        h.append("<h3>Steadiness of the benchmark figures</h3>")
+        h.append('<p class="cap">Each figure below is the median of its repetitions (interleaved: every row once per '
+                 "repetition) and, over several runs, the median of the runs' medians; error bars show the quartiles, "
+                 "ranges the minimum and maximum over every repetition used. A calibration workload timed beside every "
+                 f"row finds slow phases: a run {100 * (perf.SLOW_FACTOR - 1):.0f}% slower than the fastest is left "
+                 f"out; a row whose runs' medians span more than {100 * perf.DISAGREE:.0f}% (and more than its "
+                 "quartiles) is flagged.</p>")
+        h.append(perf.spread_table_html(rep["bench"], esc, fnum))
     h.append("<h2>1. Speed against accuracy</h2>")
+    if not rep["have_audit"]:
+        h.append('<p class="notice">No audit given: a performance-only report (run <code>rayaudit audit --json '
+                 'A.json</code> and pass <code>--audit A.json</code> for the correctness sections).</p>')
     if not rep["have_bench"]:
         h.append('<p class="notice">No benchmark given: speeds are missing (run <code>rayaudit bench --quick '
                  '--json B.json</code> and pass <code>--bench B.json</code>).</p>')
     for svg, cap in charts["speed_accuracy"]:
         h.append(chart_html(svg, cap))
+    if charts.get("kernel_hit_rate"):
+        h.append("<h3>Cost of a test against hit rate</h3>")
+        h.append(chart_html(charts["kernel_hit_rate"], "Löfstedt & Akenine-Möller's sweep: every kernel row without "
+                            "culling or back faces, at each hit rate of the batch (a test that misses early costs "
+                            "less). Error bars: quartiles; shaded: min-max over repetitions and runs. y from 0."))
     h.append('<table><tr><th class="l">method/precision</th><th>ns per test</th><th>wrong %</th><th>leaks</th>'
              '<th>leaks per million</th><th>tests</th><th class="l">breaks worst at (family@sweep)</th>'
              '<th class="l">source</th></tr>')
@@ -767,6 +907,8 @@ def page(rep, charts, methods, uris):
     h.append("<h2>2. Stability: where each method breaks</h2>")
     h.append('<p class="cap">Every audit family with a sweep. y axes are linear near 0 and logarithmic above, '
              "so a single wrong answer shows.</p>")
+    if not rep["have_audit"]:
+        h.append('<p class="notice">No audit given: no stability sweeps.</p>')
     for family, svg, cap in charts["stability"]:
         h.append(f"<h3>{esc(family)}</h3>" + chart_html(svg, cap))
 
@@ -878,11 +1020,17 @@ def main():
     for k, v in ctx.get("fs_paths", {}).items():
         ctx[k] = [os.fsdecode(bytes.fromhex(h)) for h in v] if isinstance(v, list) else os.fsdecode(bytes.fromhex(v))
     methods = Methods(ctx["methods"])
-    audit = load_json(ctx["audit"])
-    peer_subjects.register(methods, audit)
+    audit = load_json(ctx["audit"]) if ctx.get("audit") else None
+    if audit:
+        peer_subjects.register(methods, audit)
+    bench_paths = ctx.get("bench") or []
+    if isinstance(bench_paths, str):
+        bench_paths = [bench_paths]
     bench = None
-    if ctx.get("bench"):
-        bench = load_json(ctx["bench"])
+    if bench_paths:
+        loaded = [(p, load_json(p)) for p in bench_paths]
+        current_input[0] = ", ".join(bench_paths)
+        bench = perf.combine(loaded)
     cm, cm_dir = None, ctx.get("crack_maps")
     if cm_dir:
         cm = load_json(os.path.join(cm_dir, "crack_maps.json"))
@@ -897,12 +1045,16 @@ def main():
                 if line.strip():
                     name, secs = line.rstrip("\n").rsplit("\t", 1)
                     stages.append({"stage": name, "seconds": float(secs)})
-    current_input[0] = ctx["audit"]
+    current_input[0] = ctx["audit"] or current_input[0]
+    mach = machine(ctx, audit, bench, stages)
+    if bench:
+        STAMP[0] = f"{perf.mode_text(bench)}; {perf.short_machine(mach['bench_machine'])}"
 
     rep = {
         "have_bench": bench is not None,
-        "speed_accuracy": speed_accuracy(audit, bench, methods),
-        "stability": stability(audit),
+        "have_audit": audit is not None,
+        "speed_accuracy": speed_accuracy(audit, bench, methods) if audit else [],
+        "stability": stability(audit) if audit else {},
         "crack_maps": crack_maps(cm, cm_dir) if cm else [],
         "crack_meshes": cm["meshes"] if cm else [],
         "crack_legend": cm["legend"] if cm else "",
@@ -910,7 +1062,10 @@ def main():
         "peers": peers(bench) if bench else None,
         "images": images(ctx.get("compare", [])),
         "golden": golden,
-        "machine": machine(ctx, audit, bench, stages),
+        "machine": mach,
+        "bench": bench,
+        "bench_runs": [{k: v for k, v in r.items() if k != "context"} for r in bench["runs"]] if bench else [],
+        "kernel_hit_rate": perf.kernel_hit_rate(bench) if bench else {},
         "tracers": tracers_report.summary(audit),
     }
     charts = {
@@ -920,7 +1075,12 @@ def main():
         "optimisations": chart_optimisations(rep["optimisations"]) if bench else [],
         "peers": chart_peers(rep["peers"]) if bench else None,
         "tracers": tracers_report.chart(rep["tracers"], svg_of),
+        "kernel_hit_rate": None,
     }
+    if rep["kernel_hit_rate"]:
+        fig, facts = perf.chart_kernel_hit_rate(plt, rep["kernel_hit_rate"], methods, STAMP[0] + "; 4096 pairs a row")
+        CHART_FACTS.extend(facts)
+        charts["kernel_hit_rate"] = svg_of(fig)
     uris = {}
     for c in rep["crack_maps"]:
         uris[c["image"]] = data_uri(c["image"])
@@ -932,6 +1092,15 @@ def main():
     out = ctx["out_dir"]
     with open(os.path.join(out, "index.html"), "w", errors="replace") as f:
         f.write(text)
+    # Each row's figure and spread, not the combined internals.
+    if bench:
+        rep["bench"] = {"runs": rep.pop("bench_runs"), "used_runs": bench["used_runs"], "mode": STAMP[0],
+                        "rows": [{"name": n, "metric": r["_metric"], "better": r["_better"], "flagged": r["_flagged"],
+                                  "repetitions": r["_reps"]} | (r["_spread"].get(r["_metric"]) or {})
+                                 for n, r in bench["rows"].items()]}
+    else:
+        rep.pop("bench_runs")
+    rep["charts"] = CHART_FACTS
     with open(os.path.join(out, "report.json"), "w") as f:
         json.dump(finite(rep), f, indent=1, allow_nan=False, default=str)
         f.write("\n")

@@ -1,0 +1,260 @@
+// The performance report: `rayaudit bench` records each row's spread and a
+// calibration beside every repetition; `rayaudit report --bench A --bench B`
+// (no audit needed) combines runs, flags a slowed row or a slow run, and draws
+// ratios on a log axis centred on 1x with bars from 1x. No timing is asserted:
+// the slowed inputs are real runs with figures scaled here, so the expected
+// verdicts do not depend on the machine.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "run_rayaudit.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ra::test::run_rayaudit;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("rayaudit-perf-test-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+json load(const fs::path& f) {
+  std::ifstream in(f);
+  return json::parse(in);
+}
+
+void save(const fs::path& f, const json& j) { std::ofstream(f) << j.dump(1); }
+
+const char* const kRows = "'^kernel/(moller|watertight)/float/nocull/hit=(0|50|100)/back=0$'";
+
+// A real small kernel run: six rows, three repetitions each.
+json bench_run(const fs::path& out, const std::string& extra = "") {
+  const auto r = run_rayaudit("bench --quick --benchmark_repetitions=3 --benchmark_min_time=0.001 --filter " +
+                              std::string(kRows) + " --json " + out.string() + " " + extra);
+  EXPECT_EQ(r.code, 0) << r.all;
+  return load(out);
+}
+
+TEST(BenchSpread, EveryRowHasItsRepetitionsCalibrationAndSpread) {
+  const fs::path d = fresh_dir("spread");
+  const json j = bench_run(d / "b.json");
+  const json& ra = j.at("rayaudit");
+  EXPECT_EQ(ra.at("mode"), "quick");
+  EXPECT_EQ(ra.at("rounds"), 3);
+  EXPECT_FALSE(ra.at("machine").at("cpu_model").get<std::string>().empty());
+  ASSERT_EQ(ra.at("rows").size(), 6u);
+  // Every repetition is an iteration row of its own, with the calibration
+  // timed just before and just after it.
+  std::map<std::string, int> reps;
+  std::set<int> rounds;
+  for (const json& b : j.at("benchmarks"))
+    if (b.at("run_type") == "iteration") {
+      ++reps[b.at("run_name").get<std::string>()];
+      rounds.insert(b.at("rayaudit_round").get<int>());
+      EXPECT_GT(b.at("rayaudit_cal_before_us").get<double>(), 0) << b.dump();
+      EXPECT_GT(b.at("rayaudit_cal_after_cpu_us").get<double>(), 0) << b.dump();
+    }
+  EXPECT_EQ(reps.size(), 6u);
+  for (const auto& [name, n] : reps) EXPECT_GE(n, 3) << name;
+  for (int r : {0, 1, 2}) EXPECT_TRUE(rounds.count(r)) << r;
+  // A sample before each round and one after every row of it.
+  EXPECT_GE(ra.at("calibration").at("samples").size(), 3u * 7u);
+  for (const json& e : ra.at("rows")) {
+    EXPECT_EQ(e.at("metric"), "ns_per_test");
+    const double lo = e.at("min"), q1 = e.at("q1"), med = e.at("median"), q3 = e.at("q3"), hi = e.at("max");
+    EXPECT_TRUE(lo <= q1 && q1 <= med && med <= q3 && q3 <= hi) << e.dump();
+    EXPECT_GT(lo, 0) << e.dump();
+    // The median is one of the repetitions' figures or between two of them.
+    double below = 0, above = 0;
+    for (const json& b : j.at("benchmarks"))
+      if (b.at("run_type") == "iteration" && b.at("run_name") == e.at("name") && !b.at("rayaudit_slow_phase")) {
+        below += b.at("ns_per_test").get<double>() <= med;
+        above += b.at("ns_per_test").get<double>() >= med;
+      }
+    EXPECT_GE(below, 1) << e.dump();
+    EXPECT_GE(above, 1) << e.dump();
+  }
+  // compare.py's aggregates, as Google Benchmark names them.
+  std::set<std::string> aggs;
+  for (const json& b : j.at("benchmarks"))
+    if (b.at("run_type") == "aggregate") aggs.insert(b.at("name").get<std::string>());
+  EXPECT_TRUE(aggs.count("kernel/moller/float/nocull/hit=50/back=0_median"));
+  EXPECT_TRUE(aggs.count("kernel/moller/float/nocull/hit=50/back=0_cv"));
+}
+
+TEST(BenchSpread, RunsAreSeparateProcessesInOneJson) {
+  const fs::path d = fresh_dir("runs");
+  const auto r = run_rayaudit("bench --quick --runs 2 --benchmark_repetitions=2 --benchmark_min_time=0.001 "
+                              "--filter '^kernel/moller/float/nocull/hit=50/back=0$' --json " + (d / "b.json").string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.out.find("run 2 of 2"), std::string::npos) << r.out;
+  const json j = load(d / "b.json");
+  EXPECT_EQ(j.at("rayaudit").at("runs"), 2);
+  ASSERT_EQ(j.at("rayaudit").at("rows").size(), 1u);
+  EXPECT_EQ(j.at("rayaudit").at("rows")[0].at("run_medians").size(), 2u);
+  std::set<int> runs;
+  for (const json& c : j.at("rayaudit").at("calibration").at("samples")) runs.insert(c.at("run").get<int>());
+  EXPECT_EQ(runs, (std::set<int>{0, 1}));
+}
+
+// Two runs of the same rows, then copies with one row slowed (its figures
+// x1.6 in every repetition) and with a whole run slowed (figures and
+// calibration x1.4, as a slow phase does).
+TEST(ReportPerf, CombinesRunsFlagsASlowedRowAndLeavesOutASlowRun) {
+  const fs::path d = fresh_dir("combine");
+  const json a = bench_run(d / "a.json"), b = bench_run(d / "b.json");
+  const std::string slowed_row = "kernel/watertight/float/nocull/hit=50/back=0";
+  json c = b;
+  for (json& r : c.at("benchmarks"))
+    if (r.value("run_name", "") == slowed_row && r.at("run_type") == "iteration")
+      r["ns_per_test"] = r.at("ns_per_test").get<double>() * 1.6;
+  save(d / "c.json", c);
+  json s = b;
+  for (json& r : s.at("benchmarks"))
+    if (r.at("run_type") == "iteration") r["ns_per_test"] = r.at("ns_per_test").get<double>() * 1.4;
+  for (json& x : s.at("rayaudit").at("calibration").at("samples"))
+    x["us"] = x.at("us").get<double>() * 1.4, x["cpu_us"] = x.at("cpu_us").get<double>() * 1.4;
+  save(d / "s.json", s);
+
+  auto report = [&](const std::string& benches, const std::string& name) {
+    const auto r = run_rayaudit("report " + benches + " -o " + (d / name).string());
+    EXPECT_EQ(r.code, 0) << r.all;
+    return load(d / name / "report.json");
+  };
+  auto row = [](const json& rep, const std::string& name) {
+    for (const json& e : rep.at("bench").at("rows"))
+      if (e.at("name") == name) return e;
+    return json();
+  };
+  // The slowed row is flagged: its runs disagree beyond their spread.
+  const json rc = report("--bench " + (d / "a.json").string() + " --bench " + (d / "c.json").string(), "rc");
+  const json flagged = row(rc, slowed_row);
+  ASSERT_FALSE(flagged.is_null());
+  EXPECT_NE(flagged.at("flagged").get<std::string>().find("runs disagree"), std::string::npos) << flagged.dump();
+  EXPECT_EQ(rc.at("bench").at("runs").size(), 2u);
+  EXPECT_FALSE(rc.at("have_audit"));
+
+  // The slow run is named and left out: each row's figure is then from a
+  // and b alone (the median of their two medians, computed here).
+  const json rs = report("--bench " + (d / "a.json").string() + " --bench " + (d / "b.json").string() +
+                             " --bench " + (d / "s.json").string(), "rs");
+  const json& runs = rs.at("bench").at("runs");
+  ASSERT_EQ(runs.size(), 3u);
+  EXPECT_TRUE(runs[2].at("slow")) << runs.dump();
+  EXPECT_EQ(rs.at("bench").at("used_runs"), json({0, 1}));
+  auto run_median = [](const json& bench, const std::string& name) {
+    std::vector<double> v;
+    for (const json& r : bench.at("benchmarks"))
+      if (r.value("run_name", "") == name && r.at("run_type") == "iteration" && !r.at("rayaudit_slow_phase"))
+        v.push_back(r.at("ns_per_test").get<double>());
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  const std::string probe = "kernel/moller/float/nocull/hit=0/back=0";
+  const double expected = 0.5 * (run_median(a, probe) + run_median(b, probe));
+  EXPECT_NEAR(row(rs, probe).at("median").get<double>(), expected, 1e-9 * expected);
+  EXPECT_NE(row(rs, probe).at("flagged").get<std::string>().find("left out slow run(s): s.json"), std::string::npos);
+  // The kernel chart's y axis starts at 0 and holds every range.
+  bool kernel_chart = false;
+  for (const json& ch : rs.at("charts"))
+    if (ch.at("chart").get<std::string>().rfind("kernel_hit_rate/", 0) == 0) {
+      kernel_chart = true;
+      EXPECT_EQ(ch.at("ylim")[0].get<double>(), 0.0) << ch.dump();
+      for (const json& e : rs.at("bench").at("rows")) EXPECT_LE(e.at("max").get<double>(), ch.at("ylim")[1].get<double>());
+    }
+  EXPECT_TRUE(kernel_chart);
+  const std::string html = [&] {
+    std::ifstream in(d / "rs" / "index.html");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }();
+  EXPECT_NE(html.find("No audit given"), std::string::npos);
+  EXPECT_NE(html.find("quick mode, 3 repetitions x 3 run(s)"), std::string::npos);
+  EXPECT_NE(html.find("slow phase: left out of the medians"), std::string::npos);
+}
+
+// Scene and peer rows as a bench writes them (three repetitions each), with
+// chosen rates: the speed-up and peer charts' axes are centred on 1x, hold
+// every bar and error bar, start the bars at 1x, print no label over another,
+// and chart no culling of shadow rays.
+TEST(ReportPerf, RatioChartsAreCentredOnOneXWithBarsFromIt) {
+  const fs::path d = fresh_dir("ratio");
+  json benchmarks = json::array();
+  auto rep = [&](const std::string& name, const json& figures) {
+    for (int i = 0; i < 3; ++i) {
+      json r = {{"name", name}, {"run_name", name}, {"run_type", "iteration"}, {"repetitions", 3},
+                {"repetition_index", i}, {"threads", 1}, {"iterations", 1}, {"real_time", 1.0}, {"cpu_time", 1.0},
+                {"time_unit", "ns"}, {"rayaudit_slow_phase", false}};
+      for (auto it = figures.begin(); it != figures.end(); ++it) r[it.key()] = it.value().get<double>() * (1 + 0.01 * (i - 1));
+      benchmarks.push_back(r);
+    }
+  };
+  for (const char* rays : {"primary", "shadow"})
+    for (const std::string mesh : {"box", "bunny"}) {
+      const double tris = mesh == "box" ? 12 : 69666, rays_n = 4096;
+      rep("scene/" + mesh + "/none/nocull/" + rays + "/threads=1", {{"Mrays_per_s", 1.0}, {"triangles", tris}, {"rays", rays_n}});
+      rep("scene/" + mesh + "/bvh/nocull/" + rays + "/threads=1", {{"Mrays_per_s", 850.0}, {"triangles", tris}, {"rays", rays_n}});
+      rep("scene/" + mesh + "/bvh/cull/" + rays + "/threads=1", {{"Mrays_per_s", 900.0}, {"triangles", tris}, {"rays", rays_n}});
+    }
+  rep("peer/embree/bunny/primary/default/threads=1", {{"ratio", 0.9}, {"rays", 4096.0}});
+  rep("peer/cgal/bunny/primary/threads=1", {{"ratio", 1.006}, {"rays", 4096.0}});
+  rep("peer/pov/bunny/threads=1", {{"ratio", 3.2}});
+  const json bench = {{"context", {{"num_cpus", 2}}}, {"benchmarks", benchmarks},
+                      {"rayaudit", {{"mode", "quick"}, {"rounds", 3}, {"runs", 1}}}};
+  save(d / "b.json", bench);
+  const auto r = run_rayaudit("report --bench " + (d / "b.json").string() + " -o " + (d / "rep").string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  const json rep_json = load(d / "rep" / "report.json");
+  int ratio_charts = 0;
+  for (const json& ch : rep_json.at("charts")) {
+    const std::string id = ch.at("chart");
+    EXPECT_EQ(id.find("culling/shadow"), std::string::npos) << id;
+    if (ch.at("ratio_axis").is_null()) continue;
+    ++ratio_charts;
+    const json& ax = ch.at("ratio_axis");
+    const double lo = ax.at("limits")[0], hi = ax.at("limits")[1];
+    EXPECT_NEAR(lo * hi, 1.0, 1e-9) << id;  // centred on 1x on a log axis
+    EXPECT_EQ(ax.at("bars_from").get<double>(), 1.0) << id;
+    const std::string which = ax.at("axis");
+    EXPECT_EQ(ch.at(which + "scale"), "log") << id;
+    EXPECT_EQ(ch.at(which + "lim"), ax.at("limits")) << id;
+    EXPECT_EQ(ch.at("label_overlaps"), 0) << id;
+    if (id == "peers") {
+      EXPECT_LT(lo, 0.9);   // the peer ahead shows left of 1x
+      EXPECT_GT(hi, 3.2 * 1.01);  // the largest ratio and its spread
+    } else if (id.find("culling") != std::string::npos) {
+      EXPECT_GT(hi, 900.0 / 850.0 * 1.01) << id;  // culling's 1.06x and its spread
+    } else {
+      EXPECT_GT(hi, 850.0 * 1.01) << id;
+    }
+  }
+  EXPECT_GE(ratio_charts, 3);  // accelerators (primary, shadow), culling (primary), peers
+  std::ifstream in(d / "rep" / "index.html");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_NE(ss.str().find("1.01x"), std::string::npos);  // three significant digits, not "1x"
+  EXPECT_EQ(ss.str().find("e+03x"), std::string::npos);
+}
+
+TEST(ReportPerf, NeitherAuditNorBenchIsRefused) {
+  const fs::path d = fresh_dir("none");
+  const auto r = run_rayaudit("report -o " + (d / "rep").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "rayaudit report: needs --audit FILE, --bench FILE, or both\n");
+  EXPECT_FALSE(fs::exists(d / "rep"));
+}
+
+}  // namespace
