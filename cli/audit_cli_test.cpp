@@ -279,7 +279,7 @@ TEST(AuditShards, MergingShardsOfDifferentRunsIsAnErrorNamingBothFiles) {
   EXPECT_EQ(rayaudit(run + " --shard 1").code, 2);
 }
 
-// Hostile shards (issue 15's third pass): a count near 2^64 wrapped when
+// Hostile shards: a count near 2^64 wrapped when
 // merged, a shard count of 4e9 was a bad_alloc, a key given twice was
 // resolved silently, a directory was a raw library error.
 TEST(AuditShards, HostileShardsAreOneLineErrors) {
@@ -443,7 +443,7 @@ TEST(AuditGrade, NonFiniteTIsWrongAndFloatCasesAreRounded) {
 
 // Answers as spreadsheets save them: a UTF-8 BOM is dropped (it read
 // "missing column 'id'"); UTF-16 is named; a directory or FIFO as answers is
-// named, not read as "empty file" or waited on (issue 15's third pass).
+// named, not read as "empty file" or waited on.
 TEST(AuditGrade, AnswersEncodingAndNonFilesAreNamed) {
   const fs::path cases = tmp("ge_cases.csv"), answers = tmp("ge_answers.csv"), json = tmp("ge.json");
   write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\na,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
@@ -492,7 +492,7 @@ long peak_rss_kb(const std::vector<std::string>& args) {
   return ru.ru_maxrss;
 }
 
-// Issue 15: `audit --cases` held every row and its JSON (175x the CSV). Now
+// `audit --cases` held every row and its JSON (175x the CSV). Now
 // streamed: 100k rows peak where 20k do (the old code grew ~3 kB per row).
 TEST(AuditCli, CasesMemoryDoesNotGrowWithRows) {
 #if defined(__SANITIZE_ADDRESS__)

@@ -71,7 +71,7 @@ TEST(Cli, BadSceneExits2WithFileAndPath) {
   EXPECT_FALSE(fs::exists(dir / "bad.png"));
 }
 
-// The method names of issue 3, by kind: the CLI's names are a contract.
+// The documents' method names and the modern references', by kind: the CLI's names are a contract.
 const std::vector<std::string> kTriangleMethods = {"angles", "cramer", "areas", "triple",
                                                    "sameside", "moller", "watertight", "baldwin"};
 const std::vector<std::string> kSphereMethods = {"kraus", "codeproject", "codeproject-fixed", "stable"};

@@ -1,5 +1,5 @@
 // `rayaudit golden` as a user runs it, on a small repository of its own:
-// issue 15's second pass (HOSTILE2 F3-F7): a --diff-dir or --json that is
+// a --diff-dir or --json that is
 // an input or another output, a bless that fails half way, a manifest typo.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -42,7 +42,7 @@ class GoldenDataCli : public ::testing::Test {
   std::string golden_a, manifest;
 };
 
-// F3: the render written as DIFFDIR/a.png replaced golden/a.png, so the
+// The render written as DIFFDIR/a.png replaced golden/a.png, so the
 // next check passed. Refused before the work; the golden untouched.
 TEST_F(GoldenDataCli, DiffDirThatHoldsTheGoldensIsRefusedBeforeTheWork) {
   const auto r = run_rayaudit("golden check a --root " + root.string() + " --diff-dir " + (root / "golden").string());
@@ -56,7 +56,7 @@ TEST_F(GoldenDataCli, DiffDirThatHoldsTheGoldensIsRefusedBeforeTheWork) {
   EXPECT_FALSE(fs::exists(root / "golden" / "a.diff.png"));
 }
 
-// F6: --json naming one of the diff images lost the render.
+// --json naming one of the diff images lost the render.
 TEST_F(GoldenDataCli, JsonNamingADiffImageIsRefusedAsTwoOutputs) {
   fs::create_directories(root / "out");
   const auto r = run_rayaudit("golden check a --root " + root.string() + " --diff-dir " + (root / "out").string() +
@@ -67,7 +67,7 @@ TEST_F(GoldenDataCli, JsonNamingADiffImageIsRefusedAsTwoOutputs) {
   EXPECT_TRUE(fs::is_empty(root / "out"));
 }
 
-// F7: an empty --diff-dir (or --json) meant the default.
+// An empty --diff-dir (or --json) meant the default.
 TEST_F(GoldenDataCli, EmptyDiffDirOrJsonIsRefused) {
   auto r = run_rayaudit("golden check a --root " + root.string() + " --diff-dir ''");
   EXPECT_EQ(r.code, 2) << r.all;
@@ -127,7 +127,7 @@ TEST_F(GoldenDataCli, CheckEndingInABadSceneLeavesNoNewDiffFolder) {
   EXPECT_FALSE(fs::exists(root / "made")) << "a new, empty diff folder was left behind";
 }
 
-// F4: `bless a BAD` rewrote a's golden, then failed on BAD: image and
+// `bless a BAD` rewrote a's golden, then failed on BAD: image and
 // manifest disagreed. Now every scene is rendered before anything is written.
 TEST_F(GoldenDataCli, BlessOfAGoodAndABadSceneWritesNothing) {
   std::ofstream(root / "scenes" / "z.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})" << "\n";
@@ -144,7 +144,7 @@ TEST_F(GoldenDataCli, BlessOfAGoodAndABadSceneWritesNothing) {
   EXPECT_NE(slurp(root / "golden" / "a.png"), golden_a);
 }
 
-// F5: unknown keys and non-integer sizes in a manifest entry were ignored
+// Unknown keys and non-integer sizes in a manifest entry were ignored
 // or coerced (1.5 -> 1, 2^63 -> 0); each is an error at its JSON path,
 // quoting the file's value.
 TEST_F(GoldenDataCli, ManifestEntriesAreReadStrictly) {
@@ -161,7 +161,7 @@ TEST_F(GoldenDataCli, ManifestEntriesAreReadStrictly) {
       {"\"spp\": 1", "\"spp\": 3", "/goldens/0/settings/spp: spp must be a square number"},
       {"\"accel\": \"bvh\"", "\"accel\": \"fast\"", "/goldens/0/settings/accel: unknown accel \"fast\""},
       {"\"spp\": 1", "\"spp\": 1, \"zz\": 0", "/goldens/0/settings/zz: unknown key"},
-      // Taken on trust before (hostile pass): a top-level key of no meaning,
+      // Taken on trust before: a top-level key of no meaning,
       // a scene that is another golden's, two goldens sharing one image.
       {"\"goldens\":", "\"extra\": 1, \"goldens\":", "/extra: unknown key"},
       {"\"scene\": \"scenes/a.json\"", "\"scene\": \"scenes/b.json\"",
@@ -186,7 +186,7 @@ TEST_F(GoldenDataCli, ManifestEntriesAreReadStrictly) {
   }
 }
 
-// F37: bless on a full disk replaced the golden image, then failed to
+// `bless` on a full disk replaced the golden image, then failed to
 // write the manifest: image and manifest disagreed. All are renamed
 // together after the last is written, so exit 2 leaves golden/ as it was.
 TEST(GoldenFullDiskCli, BlessOnAFullDiskLeavesGoldenAsItWas) {

@@ -1,4 +1,4 @@
-// Regressions for the second hostile pass (HOSTILE2 F1, F22, F25, F27, F29,
+// Regressions for the second hostile pass (F29,
 // F30, F31, F40, F42, F43, F44): audit export/merge, report, crack-maps,
 // compare and generate, run through the real program as a user would.
 #include <gtest/gtest.h>
@@ -42,7 +42,7 @@ constexpr bool kSanitized = true;
 constexpr bool kSanitized = false;
 #endif
 
-// F1: a list of two precisions was taken as double, the float half dropped.
+// A list of two precisions was taken as double, the float half dropped.
 TEST(Hostile2Cli, ExportCasesTakesOnePrecision) {
   const fs::path out = scratch("two-precisions.csv");
   fs::remove(out);
@@ -58,7 +58,7 @@ TEST(Hostile2Cli, ExportCasesTakesOnePrecision) {
   EXPECT_NE(ok.out.find("float cases"), std::string::npos) << ok.out;
 }
 
-// F29: the export held every case in memory (840 bytes each: 300,000 cases
+// The export held every case in memory (840 bytes each: 300,000 cases
 // did not fit in 200 MB of address space); it streams now.
 TEST(Hostile2Cli, ExportCasesStreamsWithinAFixedAddressSpace) {
   if (kSanitized) GTEST_SKIP() << "prlimit --as and AddressSanitizer do not mix";
@@ -74,7 +74,7 @@ TEST(Hostile2Cli, ExportCasesStreamsWithinAFixedAddressSpace) {
   fs::remove(out);
 }
 
-// F22: a --mesh whose path is one of the maps was overwritten by that map.
+// A --mesh whose path is one of the maps was overwritten by that map.
 TEST(Hostile2Cli, CrackMapsMeshThatIsAnOutputIsRefused) {
   const fs::path dir = scratch("cm-identity");
   fs::create_directories(dir);
@@ -90,7 +90,7 @@ TEST(Hostile2Cli, CrackMapsMeshThatIsAnOutputIsRefused) {
   EXPECT_FALSE(fs::exists(dir / "crack_maps.json"));
 }
 
-// F38: the flags' own limits multiplied to ~34 hours, run silently.
+// The flags' own limits multiplied to ~34 hours, run silently.
 TEST(Hostile2Cli, CrackMapsAbsurdWorkIsRefusedWithItsSize) {
   const fs::path dir = scratch("cm-absurd");
   const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + kScenes +
@@ -101,7 +101,7 @@ TEST(Hostile2Cli, CrackMapsAbsurdWorkIsRefusedWithItsSize) {
   EXPECT_FALSE(fs::exists(dir));
 }
 
-// F31: a non-UTF-8 byte in a file name or a CSV id made the JSON writers
+// A non-UTF-8 byte in a file name or a CSV id made the JSON writers
 // throw nlohmann's type_error after the work; the bytes are now written as
 // U+FFFD and the JSON is valid.
 TEST(Hostile2Cli, NonUtf8NamesAndIdsGiveValidJson) {
@@ -146,7 +146,7 @@ TEST(Hostile2Cli, NonUtf8NamesAndIdsGiveValidJson) {
   fs::remove_all(rep);
 }
 
-// F25: inputs the C++ checks let through ended in Python tracebacks.
+// Inputs the C++ checks let through ended in Python tracebacks.
 TEST(Hostile2Cli, ReportRefusesWhatThePageCannotDrawInOneLine) {
   const fs::path audit = scratch("rep-audit.json");
   ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json " + audit.string()).code, 0);
@@ -182,7 +182,7 @@ TEST(Hostile2Cli, ReportRefusesWhatThePageCannotDrawInOneLine) {
   }
 }
 
-// F42: a UTF-8 byte-order mark before the audit JSON (the C++ check took it,
+// A UTF-8 byte-order mark before the audit JSON (the C++ check took it,
 // the script's json.load did not).
 TEST(Hostile2Cli, ReportReadsAnAuditJsonWithAByteOrderMark) {
   const fs::path audit = scratch("bom-audit.json"), out = scratch("bom-report");
@@ -195,7 +195,7 @@ TEST(Hostile2Cli, ReportReadsAnAuditJsonWithAByteOrderMark) {
   fs::remove_all(out);
 }
 
-// F40: a corrupt or huge image beside a compare JSON ended in a PIL
+// A corrupt or huge image beside a compare JSON ended in a PIL
 // traceback; now one line naming the image, exit 2, nothing written.
 TEST(Hostile2Cli, ReportNamesAnUnreadableOrHugeImageInOneLine) {
   const fs::path audit = scratch("img-audit.json"), dir = scratch("img-cmp");
@@ -254,7 +254,7 @@ int processes_in(const fs::path& dir, pid_t parent = 0) {
   return n;
 }
 
-// F30: an interrupted compare left POV-Ray running as an orphan and its
+// An interrupted compare left POV-Ray running as an orphan and its
 // working directory in /tmp. Now the signal kills POV-Ray, removes the
 // directory and ends rayaudit with that signal.
 TEST(Hostile2Cli, InterruptedCompareLeavesNoPovRayAndNoDirectory) {
@@ -294,8 +294,8 @@ TEST(Hostile2Cli, InterruptedCompareLeavesNoPovRayAndNoDirectory) {
   }
 }
 
-// F27: impossible counts and unknown keys in a shard were merged as given;
-// F26: a hostile shard was held at ~30x its size (a bare std::bad_alloc).
+// Impossible counts and unknown keys in a shard were merged as given;
+// a hostile shard was held at ~30x its size (a bare std::bad_alloc).
 TEST(Hostile2Cli, MergeRefusesImpossibleStatsUnknownKeysAndHugeShards) {
   const fs::path sh1 = scratch("sh1.json"), sh2 = scratch("sh2.json"), out = scratch("merged.json");
   ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 1/2 --json " + sh1.string()).code, 0);
@@ -344,7 +344,7 @@ TEST(Hostile2Cli, MergeRefusesImpossibleStatsUnknownKeysAndHugeShards) {
   EXPECT_EQ(run_rayaudit("audit merge " + sh1.string() + " " + sh2.string() + " --json " + out.string()).code, 0);
 }
 
-// F43: generate teapot took 1e400 as a bare "stod", accepted malformed
+// `generate teapot` took 1e400 as a bare "stod", accepted malformed
 // patches, and tessellated any number of patches at --steps 256 (16.8 GB).
 TEST(Hostile2Cli, TeapotIncIsCheckedAndItsWorkBounded) {
   const std::string head = "bicubic_patch { type 1 flatness 0.01 u_steps 5 v_steps 5\n";

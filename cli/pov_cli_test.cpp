@@ -135,7 +135,7 @@ TEST(CompareCli, OneUnwritableOutputMeansNoOutputAtAll) {
 }
 
 // An image output in a format compare cannot write is refused with the
-// other destination checks, before either render (HOSTILE2 F44: after both,
+// other destination checks, before either render (after both,
 // with the comparison already printed).
 TEST(CompareCli, UnsupportedImageFormatIsRefusedBeforeRendering) {
   const fs::path dir = temp_dir("compare-format");

@@ -120,7 +120,7 @@ TEST(ReliabilityCli, VersionEndsWithANewline) {
 
 // What a command prints must arrive: on a full disk (/dev/full) every
 // command that writes to stdout says so in one line with exit 2; it exited
-// 0 and left `info --json > f` empty (hostile pass).
+// 0 and left `info --json > f` empty.
 TEST(ReliabilityCli, StdoutOnAFullDiskIsAnError) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
   for (const std::string& args : std::vector<std::string>{"--version", "methods", "methods --json",
@@ -314,8 +314,8 @@ TEST(ReliabilityCli, Texture16384OneBitLoadsInItsOwnBytesOrIsRefusedUpFront) {
 
 // Under an address-space limit too low for OpenImageIO's libraries (they
 // map ~430 MB and start threads as they load), every image command aborted,
-// segfaulted or hung at 410-450 MB, or blamed a valid texture up to ~520 MB
-// (HOSTILE2 F28). The module is refused before it is loaded, in one line.
+// segfaulted or hung at 410-450 MB, or blamed a valid texture up to ~520 MB.
+// The module is refused before it is loaded, in one line.
 TEST(ReliabilityCli, ImageModuleUnderALowAddressSpaceLimitIsOneLine) {
   SKIP_IF_SANITIZED();
   for (const char* limit : {"300000000", "410000000", "430000000", "450000000", "500000000"}) {
@@ -362,7 +362,7 @@ fs::path textured_scene_dir(const std::string& name) {
 
 // An output that is one of the command's inputs (the scene, the mesh or
 // texture it references, the cases CSV) is refused before the work: the
-// rename replaced the input (issue 15's second pass: `render s.json -o
+// rename replaced the input (`render s.json -o
 // tex.png`, `export-pov --ini s.json`, `audit --cases c.csv --json c.csv`).
 TEST(ReliabilityCli, OutputThatIsAnInputIsRefusedAndTheInputKept) {
   const fs::path d = textured_scene_dir("out-is-input");
@@ -601,7 +601,7 @@ TEST(ReliabilityCli, CompareRandomOutWithAMissingParentIsRefused) {
 
 }  // namespace
 
-// Issue 15's fourth pass: `audit --json ""` wrote nothing and exited 0; every
+// `audit --json ""` wrote nothing and exited 0; every
 // option given an empty value is refused by name before any work.
 TEST(ReliabilityCli, EmptyOptionValuesAreRefusedByName) {
   const fs::path dir = scratch("empty-values");
@@ -627,7 +627,7 @@ TEST(ReliabilityCli, EmptyOptionValuesAreRefusedByName) {
   fs::remove_all(dir);
 }
 
-// Issue 15's fourth pass: `golden check --diff-dir ROOT/golden` replaced the
+// `golden check --diff-dir ROOT/golden` replaced the
 // golden it compared against with this render (the next check passed);
 // --json naming a diff image lost the render; `golden bless A BAD` rewrote
 // A's image and failed on BAD, leaving the manifest stale.
@@ -665,7 +665,7 @@ TEST(ReliabilityCli, GoldenOutputsNeverReplaceInputsAndBlessIsAllOrNothing) {
   fs::remove_all(root);
 }
 
-// HOSTILE2 F1, F2: a second precision for --export-cases was dropped
+// A second precision for --export-cases was dropped
 // silently (a file of double cases, exit 0); `--version extra` exited 0.
 TEST(ReliabilityCli, ExportCasesWithTwoPrecisionsAndVersionWithAnArgumentAreRefused) {
   const fs::path out = scratch("two-precisions.csv");
@@ -682,7 +682,7 @@ TEST(ReliabilityCli, ExportCasesWithTwoPrecisionsAndVersionWithAnArgumentAreRefu
   fs::remove(out);
 }
 
-// HOSTILE2 F22: an OBJ read through its memory map was not noted as an
+// An OBJ read through its memory map was not noted as an
 // input, so `crack-maps --mesh` naming one of its own maps overwrote it.
 TEST(ReliabilityCli, CrackMapsMeshThatIsOneOfItsMapsIsRefused) {
   const fs::path dir = scratch("cm-mesh-input");
@@ -701,7 +701,7 @@ TEST(ReliabilityCli, CrackMapsMeshThatIsOneOfItsMapsIsRefused) {
   fs::remove_all(dir);
 }
 
-// HOSTILE2 F31, F32, F39: a non-UTF-8 CSV id made the JSON writer throw
+// A non-UTF-8 CSV id made the JSON writer throw
 // after the work; info read a PLY or a scene as an empty OBJ (exit 0); an
 // OBJ reader trusting st_size read /proc files as empty.
 TEST(ReliabilityCli, NonUtf8IdsInfoOnNonObjAndProcFiles) {
@@ -722,7 +722,7 @@ TEST(ReliabilityCli, NonUtf8IdsInfoOnNonObjAndProcFiles) {
   fs::remove_all(dir);
 }
 
-// HOSTILE2 F42: an audit JSON with a UTF-8 BOM passed the C++ checks and
+// An audit JSON with a UTF-8 BOM passed the C++ checks and
 // ended in a 13-line Python traceback; report.py reads it as utf-8-sig.
 TEST(ReliabilityCli, ReportReadsAnAuditJsonWithABom) {
   const fs::path dir = scratch("report-bom");
@@ -737,7 +737,7 @@ TEST(ReliabilityCli, ReportReadsAnAuditJsonWithABom) {
   fs::remove_all(dir);
 }
 
-// HOSTILE2 F40: an image beside a compare JSON that PIL cannot open ended
+// An image beside a compare JSON that PIL cannot open ended
 // the report in a 13-line traceback; it is one line naming the image.
 TEST(ReliabilityCli, ReportWithAnUnreadableCompareImageIsOneLine) {
   const fs::path dir = scratch("report-f40");
@@ -756,7 +756,7 @@ TEST(ReliabilityCli, ReportWithAnUnreadableCompareImageIsOneLine) {
   fs::remove_all(dir);
 }
 
-// HOSTILE2 F19 addendum: a 10 MB usemtl name was a 10 MB warning line.
+// A 10 MB usemtl name was a 10 MB warning line.
 TEST(ReliabilityCli, LongMaterialNamesAreQuotedShort) {
   const fs::path obj = scratch("long-usemtl.obj");
   std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl " << std::string(1000000, 'u') << "\nf 1 2 3\n";
@@ -766,7 +766,7 @@ TEST(ReliabilityCli, LongMaterialNamesAreQuotedShort) {
   EXPECT_NE(r.err.find("... (1000000 bytes)' is not defined"), std::string::npos) << r.err.substr(0, 300);
 }
 
-// HOSTILE2 F23: `golden check /elsewhere/x.json` checked ROOT/scenes/x.json
+// `golden check /elsewhere/x.json` checked ROOT/scenes/x.json
 // and named that file; a path outside scenes/ is refused as such, and an
 // absolute path inside it is its scene.
 TEST(ReliabilityCli, GoldenCheckOfAPathOutsideScenesIsNamedAsSuch) {

@@ -1,5 +1,5 @@
 // `rayaudit render` on scenes that are large or extreme rather than
-// malformed (issue 15's second pass, HOSTILE2 F17-F20): many objects, a
+// malformed: many objects, a
 // repeated mesh, a 100 MB path, a radiance beyond a float.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -67,7 +67,7 @@ constexpr bool kSanitized = true;
 constexpr bool kSanitized = false;
 #endif
 
-// F17: one mesh placed 400 times was loaded and given a BVH 400 times (a
+// One mesh placed 400 times was loaded and given a BVH 400 times (a
 // 69,666-triangle mesh: 3.5 GB). A 20,000-triangle mesh placed 400 times
 // (about 1.6 GB as 400 copies) now renders under a 1 GB address-space limit.
 TEST(RenderLimitsCli, AMeshPlaced400TimesIsLoadedOnce) {
@@ -97,7 +97,7 @@ TEST(RenderLimitsCli, AMeshPlaced400TimesIsLoadedOnce) {
   EXPECT_TRUE(fs::exists(png));
 }
 
-// F18: 10,000 spheres were intersected by a loop over all of them (15 s at
+// 10,000 spheres were intersected by a loop over all of them (15 s at
 // 320x240); through the object BVH they are a fraction of a second. Under a
 // 20 s CPU limit (a bound against runaway, not a timing), on one thread.
 TEST(RenderLimitsCli, TenThousandSpheresAreBoundedByTheObjectBvh) {
@@ -116,7 +116,7 @@ TEST(RenderLimitsCli, TenThousandSpheresAreBoundedByTheObjectBvh) {
   EXPECT_TRUE(fs::exists(png));
 }
 
-// F28: under an address-space limit of 410-450 MB every image command
+// Under an address-space limit of 410-450 MB every image command
 // aborted (134), crashed (139) or hung inside dlopen, where threads
 // OpenImageIO's libraries start were refused; at 460-520 MB a valid texture
 // was "cannot be allocated". Now one line naming the limit, before dlopen.

@@ -1,4 +1,4 @@
-// The report in a real browser (issue 14): a report from a real small run
+// The report in a real browser: a report from a real small run
 // opens in headless Chromium with every image and chart drawn, no console error.
 #include <gtest/gtest.h>
 #include <sys/wait.h>

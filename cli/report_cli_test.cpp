@@ -1,4 +1,4 @@
-// `rayaudit report` and `rayaudit crack-maps` (issue 14): bad input is one line
+// `rayaudit report` and `rayaudit crack-maps`: bad input is one line
 // and exit 2 with nothing written; crack maps' counts match their images.
 // The browser test is report_browser_test.cpp.
 #include <gtest/gtest.h>

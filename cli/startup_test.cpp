@@ -1,4 +1,5 @@
-// Issue 15: OpenImageIO (~260 libraries, 130 MB) is loaded only by commands
+// Start-up cost: every process started at 132 MB and 0.14-0.27 s, even
+// --version. OpenImageIO (~260 libraries, 130 MB) is loaded only by commands
 // that touch an image (renderer/image_module.h). The dynamic loader's own
 // log (LD_DEBUG=files) says which libraries a run mapped.
 #include <gtest/gtest.h>

@@ -204,7 +204,7 @@ TEST(Triangulate, ConvexPolygonOf300kCornersIsAFan) {
   EXPECT_NEAR(area2d(p, out), 0.5 * n * std::sin(2 * M_PI / n), 1e-9);
 }
 
-// A star whose inner corners lie at 1% of its radius (hostile pass): they
+// A star whose inner corners lie at 1% of its radius: they
 // shared one or two cells of a grid over the whole polygon, so every
 // spike's ear scanned all of them, the work limit was spent and the fan
 // came out 118 times the star's area. The grid over the reflex corners

@@ -155,7 +155,7 @@ struct Tracer::Impl {
     shadow_cache_level1.assign(s.lights.size(), -1);
     shadow_cache_other.assign(s.lights.size(), -1);
     // A set placed by several objects (a scene repeating one mesh) is
-    // prepared once (HOSTILE2 F17: 400 placements, 400 BVHs, 3.5 GB).
+    // prepared once (400 placements, 400 BVHs, 3.5 GB).
     std::map<const TriangleSet*, int> prepared;
     for (std::size_t i = 0; i < s.objects.size(); ++i) {
       if (s.objects[i].kind != Object::Kind::mesh) continue;
@@ -202,7 +202,7 @@ struct Tracer::Impl {
   // Bounding_Threshold (3) of them; with --accel bvh so do we: a BVH over
   // the boxes of the spheres and meshes (a lone triangle is a one-triangle
   // mesh), planes tested for every ray. 30,000 lone triangles took 31 s at
-  // 64x64 by a loop over all objects (HOSTILE2 F18). The image is the same
+  // 64x64 by a loop over all objects. The image is the same
   // bits as that loop's (ties on t go to the lower object whatever the
   // order; object_bvh = false renders the loop for the identity tests),
   // provided every hit a kernel reports lies in its object's box:
@@ -368,7 +368,7 @@ struct Tracer::Impl {
     // The BVH's boxes and the bounding sphere are widened by it: a float
     // kernel answers for the ray rounded to float, whose origin far out
     // moves by 2^-24 of its distance (at 1e6, 0.06), so its hits can lie
-    // outside the mesh's exact sphere (hostile pass: 182 pixels lost at 1e6).
+    // outside the mesh's exact sphere (182 pixels lost at 1e6).
     m.pad = 1e-5 * std::max(length(hi - lo), std::max(max_component(abs(lo)), max_component(abs(hi))));
     m.lo = lo - Vec3d{m.pad, m.pad, m.pad};
     m.hi = hi + Vec3d{m.pad, m.pad, m.pad};
@@ -857,7 +857,7 @@ struct Tracer::Impl {
   // shadow or reflected ray leaving a smooth-shaded point near the
   // terminator can run into the mesh (its shading normal faces the light,
   // its geometric normal away), where culled back faces let it through
-  // (a lit seam; hostile pass). Secondary rays are never culled.
+  // (a lit seam). Secondary rays are never culled.
   template <class T>
   std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1, bool cull = false) const {
     if (one_mesh_tri4 && only <= 0)

@@ -1,5 +1,5 @@
 // The BVH over a scene's objects (render.cpp, POV-Ray's automatic bounding;
-// HOSTILE2 F17, F18): the same image, bit for bit, as the loop over every
+// scenes of thousands of objects): the same image, bit for bit, as the loop over every
 // object, for every method and precision; a repeated mesh is one set.
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,5 +1,5 @@
 // located(): one printable line of bounded length whatever the input quoted
-// (issue 15's second pass: a 100 MB path in a scene was a 100 MB line).
+// (a 100 MB path in a scene was a 100 MB line).
 #include <gtest/gtest.h>
 
 #include <string>
