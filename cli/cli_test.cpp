@@ -21,15 +21,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out;  // stdout and stderr
-};
-
-Result run(const std::string& args) {
-  const auto r = ra::test::run_rayaudit(args);
-  return {r.code, r.all};
-}
+using ra::test::Result;
+using ra::test::run;
 
 fs::path temp_dir() {
   fs::path d = fs::temp_directory_path() / ("rayaudit-cli-" + std::to_string(::getpid()));

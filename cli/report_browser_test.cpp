@@ -15,14 +15,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using ra::test::run_rayaudit;
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using namespace ra::test;
 
 // Runs a command, returning its exit code and putting stdout + stderr in `out`.
 int sh(const std::string& cmd, std::string& out) {

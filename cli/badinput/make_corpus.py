@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # Writes the bad-input corpus beside this script: one directory per
-# input kind; cli/badinput_test.cpp runs each file through rayaudit.
+# input kind; cli/badinput_corpus_test.cpp runs each file through rayaudit.
 # The files are committed; this script only documents how the binary ones
 # were made (rerun it after changing one). Expected messages: expected.tsv.
 import os, struct, zlib

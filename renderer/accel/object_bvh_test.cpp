@@ -97,8 +97,8 @@ TEST(ObjectBvh, SameBitsAsTheLoopOverObjectsForEveryMethodAndPrecision) {
       o.object_bvh = true;
       const Image bvh = render(scene, o);
       EXPECT_EQ(loop.rgb, bvh.rgb) << m.name << " / " << o.sphere_method << (dbl ? " double" : " float");
-      // Asking for the nodes and leaves beside those met (every BVH: the
-      // objects', the soup's and each mesh's) changes no bit.
+      // Asking for the nodes and leaves beside those met (the soup's BVH
+      // and each mesh's; the objects' BVH never asks) changes no bit.
       o.neighbour_prefetch = RenderOptions::NeighbourPrefetch::always;
       EXPECT_EQ(loop.rgb, render(scene, o).rgb) << m.name << " with neighbour prefetch";
       for (float v : loop.rgb) nonblack += v > 0.05f;
