@@ -221,7 +221,7 @@ struct Tracer::Impl {
   //    object), as a soup about the same.
   static constexpr std::size_t kObjectBvhMin = 3;
   bool objects_bounded = false;  // the object BVH (and soup) in use
-  Bvh object_bvh;                // over bounded[]
+  Bvh object_bvh;                // over bounded[]; never prefetch_neighbours (traversed without those loops)
   std::vector<int> bounded;      // slot order -> object index
   std::vector<int> unbounded;    // planes
   double reach = 0;              // rays with |o_a| <= reach use object_bvh
@@ -671,7 +671,7 @@ struct Tracer::Impl {
           });
         }
       }
-      traverse<true, kFma>(object_bvh, window.o, window.d, window.tmin, window.tmax,
+      traverse<true, kFma, false>(object_bvh, window.o, window.d, window.tmin, window.tmax,
                            [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                              for (std::uint32_t slot = first; slot < first + count; ++slot)
                                visit(std::size_t(bounded[slot]), true);
@@ -811,7 +811,7 @@ struct Tracer::Impl {
         }
         if (hit) return true;
       }
-      traverse<false, kFma>(object_bvh, r.o, r.d, r.tmin, r.tmax,
+      traverse<false, kFma, false>(object_bvh, r.o, r.d, r.tmin, r.tmax,
                             [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                               for (std::uint32_t slot = first; slot < first + count; ++slot)
                                 if (visit(std::size_t(bounded[slot]), true)) return hit = true;
