@@ -127,14 +127,18 @@ TEST(InputsCli, ExportPovWithATruncatedTextureIsOneLine) {
 // OBJ reader trusting st_size read /proc files as empty.
 TEST(InputsCli, NonUtf8IdsInfoOnNonObjAndProcFiles) {
   const fs::path dir = scratch_dir("non-utf8-ids");
-  std::ofstream(dir / "c.csv") << "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n\xff\xfex,0,0,5,0,0,-1,-1,-1,0,1,-1,0,0,1,0\n";
-  auto r = run_rayaudit("audit --cases " + (dir / "c.csv").string() + " --methods moller --json " + (dir / "o.json").string());
+  std::ofstream(dir / "c.csv")
+      << "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n\xff\xfex,0,0,5,0,0,-1,-1,-1,0,1,-1,0,0,1,0\n";
+  auto r = run_rayaudit("audit --cases " + (dir / "c.csv").string() + " --methods moller --json " +
+                        (dir / "o.json").string());
   EXPECT_EQ(r.code, 0) << r.all;
-  EXPECT_NE(slurp(dir / "o.json").find("\"id\": \"\xEF\xBF\xBD\xEF\xBF\xBDx\""), std::string::npos) << "replaced, valid UTF-8";
+  EXPECT_NE(slurp(dir / "o.json").find("\"id\": \"\xEF\xBF\xBD\xEF\xBF\xBDx\""), std::string::npos)
+      << "replaced, valid UTF-8";
   std::ofstream(dir / "t.ply") << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
   r = run_rayaudit("info " + (dir / "t.ply").string());
   EXPECT_EQ(r.code, 2) << r.all;
-  EXPECT_EQ(r.err, (dir / "t.ply").string() + ": a ply file: info reads OBJ meshes (rayaudit convert it to OBJ first)\n");
+  EXPECT_EQ(r.err,
+            (dir / "t.ply").string() + ": a ply file: info reads OBJ meshes (rayaudit convert it to OBJ first)\n");
   r = run_rayaudit("info /proc/self/status");
   EXPECT_EQ(r.code, 0) << r.all;
   EXPECT_NE(r.err.find("/proc/self/status:1: unsupported statement 'Name:'"), std::string::npos) << r.err;
@@ -182,13 +186,16 @@ TEST(InputsCli, NonUtf8NamesAndIdsGiveValidJson) {
     while (std::getline(in, line)) a << line.substr(0, line.find(',')) << ",false,\n";
   }
   const fs::path graded = scratch("latin1-graded.json");
-  r = run_rayaudit("audit --grade '" + answers.string() + "' --cases " + exported.string() + " --json " + graded.string());
+  r = run_rayaudit("audit --grade '" + answers.string() + "' --cases " + exported.string() + " --json " +
+                   graded.string());
   EXPECT_EQ(r.code, 0) << r.all;
   EXPECT_NE(slurp(graded).find("ans\xef\xbf\xbd"), std::string::npos);
   // report from a directory whose name is not UTF-8: the script opens it.
   const fs::path dir = scratch("d\xff");
   fs::create_directories(dir);
-  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json '" + (dir / "a.json").string() + "'").code, 0);
+  ASSERT_EQ(
+      run_rayaudit("audit --methods moller --families edge --rays 50 --json '" + (dir / "a.json").string() + "'").code,
+      0);
   const fs::path rep = scratch("latin1-report");
   r = run_rayaudit("report --audit '" + (dir / "a.json").string() + "' -o " + rep.string());
   EXPECT_EQ(r.code, 0) << r.all;
@@ -207,25 +214,29 @@ TEST(InputsCli, TeapotIncIsCheckedAndItsWorkBounded) {
     int steps;
   };
   const std::vector<Case> cases = {
-      {"e.inc", head + "<1e400, 0, 2.4> <1.4, -0.784, 2.4> <0.784, -1.4, 2.4> <0, -1.4, 2.4>\n" + row + row + row + "}\n",
+      {"e.inc",
+       head + "<1e400, 0, 2.4> <1.4, -0.784, 2.4> <0.784, -1.4, 2.4> <0, -1.4, 2.4>\n" + row + row + row + "}\n",
        "e.inc:2: number '1e400' is not a finite number within 1e30", 8},
-      {"twenty.inc", head + row + row + row + row + row + "}\n", "twenty.inc:1: bicubic_patch with 20 control points (16 needed)", 8},
+      {"twenty.inc", head + row + row + row + row + row + "}\n",
+       "twenty.inc:1: bicubic_patch with 20 control points (16 needed)", 8},
       {"unclosed.inc", head + row + row + row + row, "unclosed.inc:1: bicubic_patch without a closed { ... }", 8},
       {"two.inc", head + "<1,2> " + row + row + row + row + "}\n", "two.inc:2: vector with 2 components (3 needed)", 8},
-      {"many.inc", [&] {
+      {"many.inc",
+       [&] {
          std::string t;
          for (int i = 0; i < 100; ++i) t += patch;
          return t;
        }(),
-       "many.inc: 100 patches at --steps 256 make 13107200 triangles (about 5242 MB); at most 1048576: a smaller --steps",
+       "many.inc: 100 patches at --steps 256 make 13107200 triangles (about 5242 MB); at most 1048576: a smaller "
+       "--steps",
        256},
   };
   const fs::path out = scratch("teapot.obj");
   for (const auto& c : cases) {
     const fs::path inc = scratch(c.name);
     std::ofstream(inc) << c.text;
-    const auto r = run_rayaudit("generate teapot " + inc.string() + " -o " + out.string() + " --steps " +
-                                std::to_string(c.steps));
+    const auto r =
+        run_rayaudit("generate teapot " + inc.string() + " -o " + out.string() + " --steps " + std::to_string(c.steps));
     EXPECT_EQ(r.code, 2) << r.all;
     EXPECT_EQ(r.err, scratch("").string() + c.message + "\n");
     EXPECT_FALSE(fs::exists(out));

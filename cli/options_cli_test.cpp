@@ -25,7 +25,8 @@ TEST(OptionsCli, VersionEndsWithANewline) {
 TEST(OptionsCli, PngOptionsWithAnExrAreRefused) {
   const fs::path out = scratch("png_opts.exr");
   for (const char* opt : {"--srgb", "--bits 16"}) {
-    const auto r = run_rayaudit("render " + kScenes + "/meshes/tetrahedron.obj -o " + out.string() + " --width 8 --height 8 " + opt);
+    const auto r = run_rayaudit("render " + kScenes + "/meshes/tetrahedron.obj -o " + out.string() +
+                                " --width 8 --height 8 " + opt);
     EXPECT_EQ(r.code, 2) << opt;
     EXPECT_EQ(r.err, out.string() + ": --srgb and --bits apply to PNG; an EXR holds the linear float values\n") << opt;
     EXPECT_FALSE(fs::exists(out));
@@ -47,12 +48,14 @@ TEST(OptionsCli, ListOptionsWithAnEmptyItemAreRefused) {
     std::string args, says;
   };
   for (const Case& c : std::vector<Case>{
-           {"audit --rays 5 --families edge,,vertex --json " + out.string(), "--families: empty item in the list 'edge,,vertex'"},
+           {"audit --rays 5 --families edge,,vertex --json " + out.string(),
+            "--families: empty item in the list 'edge,,vertex'"},
            {"audit --rays 5 --families , --json " + out.string(), "--families: empty item in the list ','"},
            {"audit --rays 5 --methods moller, --json " + out.string(), "--methods: empty item in the list 'moller,'"},
            {"audit --rays 5 --precision float, --json " + out.string(), "--precision: empty item in the list 'float,'"},
            {"audit --rays 5 --methods '' --json " + out.string(), "--methods: empty list"},
-           {"crack-maps -o " + scratch("cm-list").string() + " --offsets 1,,2", "--offsets: empty item in the list '1,,2'"}}) {
+           {"crack-maps -o " + scratch("cm-list").string() + " --offsets 1,,2",
+            "--offsets: empty item in the list '1,,2'"}}) {
     const auto r = run_rayaudit(c.args);
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.all;
     EXPECT_TRUE(one_line(r.err)) << r.err;

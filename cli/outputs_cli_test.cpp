@@ -31,7 +31,8 @@ TEST(OutputsCli, RenderOnAFullDiskExits2AndKeepsTheGoodPng) {
 
 // A missing output directory is found before a 16384 x 16384 render, not after.
 TEST(OutputsCli, RenderChecksTheDestinationBeforeTheWork) {
-  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 -o /nonexistent-dir/x.png");
+  const auto r =
+      run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 -o /nonexistent-dir/x.png");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "/nonexistent-dir/x.png: output directory does not exist\n");
 }
@@ -41,9 +42,9 @@ TEST(OutputsCli, RenderChecksTheDestinationBeforeTheWork) {
 // 0 and left `info --json > f` empty.
 TEST(OutputsCli, StdoutOnAFullDiskIsAnError) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
-  for (const std::string& args : std::vector<std::string>{"--version", "methods", "methods --json",
-                                                           "info " + kScenes + "/meshes/tetrahedron.obj",
-                                 "info --json " + kScenes + "/meshes/tetrahedron.obj"}) {
+  for (const std::string& args :
+       std::vector<std::string>{"--version", "methods", "methods --json", "info " + kScenes + "/meshes/tetrahedron.obj",
+                                "info --json " + kScenes + "/meshes/tetrahedron.obj"}) {
     const auto r = run_rayaudit(args + " >/dev/full");
     EXPECT_EQ(r.code, 2) << args;
     EXPECT_EQ(r.err, "rayaudit: cannot write to standard output: No space left on device\n") << args;
@@ -64,8 +65,8 @@ TEST(OutputsCli, OutputUnderARegularFileIsNamed) {
 TEST(OutputsCli, ExportPovWithIniEqualToOutputIsRefused) {
   const fs::path pov = scratch("same.pov");
   std::ofstream(pov) << "precious";
-  const auto r = run_rayaudit("export-pov " + kScenes + "/doc000-pyramid.json -o " + pov.string() + " --ini " +
-                              pov.string());
+  const auto r =
+      run_rayaudit("export-pov " + kScenes + "/doc000-pyramid.json -o " + pov.string() + " --ini " + pov.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, pov.string() + ": --ini names the same file as -o\n");
   EXPECT_EQ(slurp(pov), "precious");
@@ -85,9 +86,9 @@ TEST(OutputsCli, OutputThatIsAFifoIsRefusedNotReplaced) {
   const fs::path fifo = scratch("out-fifo.png");
   fs::remove(fifo);
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
-  for (const std::string& args : std::vector<std::string>{
-           "render " + kScenes + "/doc000-pyramid.json --width 8 --height 8 -o " + fifo.string(),
-           "audit --rays 100 --families edge --json " + fifo.string()}) {
+  for (const std::string& args :
+       std::vector<std::string>{"render " + kScenes + "/doc000-pyramid.json --width 8 --height 8 -o " + fifo.string(),
+                                "audit --rays 100 --families edge --json " + fifo.string()}) {
     const auto r = run_rayaudit(args);
     EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
     EXPECT_EQ(r.err, fifo.string() + ": is a FIFO, not a file: not replaced\n") << args;
@@ -110,11 +111,11 @@ TEST(OutputsCli, OutputThatIsAnInputIsRefusedAndTheInputKept) {
     std::string args;
     fs::path input;
   };
-  for (const Case& c : std::vector<Case>{
-           {"render " + s + " -o " + (d / "tex.png").string(), d / "tex.png"},
-           {"render " + s + " -o " + (d / "link.png").string(), d / "tex.png"},
-           {"export-pov " + s + " -o " + (d / "x.pov").string() + " --ini " + s, d / "s.json"},
-           {"audit --cases " + cases.string() + " --methods moller --json " + cases.string(), cases}}) {
+  for (const Case& c :
+       std::vector<Case>{{"render " + s + " -o " + (d / "tex.png").string(), d / "tex.png"},
+                         {"render " + s + " -o " + (d / "link.png").string(), d / "tex.png"},
+                         {"export-pov " + s + " -o " + (d / "x.pov").string() + " --ini " + s, d / "s.json"},
+                         {"audit --cases " + cases.string() + " --methods moller --json " + cases.string(), cases}}) {
     const std::string before = slurp(c.input);
     const auto r = run_rayaudit(c.args);
     EXPECT_EQ(r.code, 2) << c.args << "\n" << r.all;
@@ -131,10 +132,10 @@ TEST(OutputsCli, OutputThatIsAnInputIsRefusedAndTheInputKept) {
 TEST(OutputsCli, TwoOutputsOnOnePathAreRefused) {
   const fs::path d = textured_scene_dir("two-outputs");
   const std::string same = (d / "same").string();
-  for (const std::string& args : std::vector<std::string>{
-           "audit --rays 50 --families edge --methods moller --json " + same + " --csv " + same,
-           "export-pov " + (d / "s.json").string() + " -o " + (d / "x.pov").string() + " --ini " +
-               (d / "x-tex0.png").string()}) {
+  for (const std::string& args :
+       std::vector<std::string>{"audit --rays 50 --families edge --methods moller --json " + same + " --csv " + same,
+                                "export-pov " + (d / "s.json").string() + " -o " + (d / "x.pov").string() + " --ini " +
+                                    (d / "x-tex0.png").string()}) {
     const auto r = run_rayaudit(args);
     EXPECT_EQ(r.code, 2) << args << "\n" << r.all;
     EXPECT_TRUE(one_line(r.err)) << r.err;

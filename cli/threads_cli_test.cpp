@@ -49,8 +49,10 @@ TEST(ThreadsCli, AuditJsonIsIdenticalFor1And2And7Threads) {
   for (int n : {1, 2, 7}) {
     const fs::path j = scratch("audit-t" + std::to_string(n) + ".json");
     ASSERT_EQ(run_rayaudit("audit --rays 2000 --threads " + std::to_string(n) + " --json " + j.string()).code, 0);
-    if (first.empty()) first = slurp(j);
-    else EXPECT_EQ(slurp(j), first) << n << " threads";
+    if (first.empty())
+      first = slurp(j);
+    else
+      EXPECT_EQ(slurp(j), first) << n << " threads";
   }
   EXPECT_GT(first.size(), 1000u);
 }

@@ -119,7 +119,8 @@ TEST(Triangulate, PolygonBeyondTheWorkLimitIsOneWarningNamingItsLine) {
     EXPECT_NE(m.warnings[0].find("(3 polygons)"), std::string::npos) << m.warnings[0];
   }
   // A concave polygon within the limit: no warning.
-  const Mesh u = parse_obj("v 0 0 0\nv 3 0 0\nv 3 2 0\nv 2 2 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6 7 8\n", "u.obj");
+  const Mesh u =
+      parse_obj("v 0 0 0\nv 3 0 0\nv 3 2 0\nv 2 2 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6 7 8\n", "u.obj");
   EXPECT_EQ(u.triangles.size(), 6u);
   EXPECT_TRUE(u.warnings.empty());
 }
@@ -138,8 +139,8 @@ TEST(Triangulate, DegeneratePolygonOf60kCornersIsCutAsAFan) {
 // Extents that overflow (1e308 - -1e308 = inf) must not break the grid of
 // reflex corners (the cell of NaN was undefined behaviour).
 TEST(Triangulate, OverflowingExtentsStillGiveNMinus2Triangles) {
-  const std::vector<Vec3d> p = {{-1e308, 0, 0}, {0, -1e308, 0}, {1e308, 0, 0}, {0, 1e-300, 0},
-                                {-1e307, 1e308, 0}, {-5e307, 1e307, 0}};
+  const std::vector<Vec3d> p = {{-1e308, 0, 0}, {0, -1e308, 0},     {1e308, 0, 0},
+                                {0, 1e-300, 0}, {-1e307, 1e308, 0}, {-5e307, 1e307, 0}};
   std::vector<std::array<int, 3>> out;
   EarClipScratch s;
   triangulate_polygon(p.data(), int(p.size()), out, s);
