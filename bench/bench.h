@@ -1,4 +1,4 @@
-// rayaudit-bench (issue 13): one Google Benchmark program for the methods,
+// rayaudit-bench: one Google Benchmark program for the methods,
 // the documents' optimisations and the peers. Shared pieces of its groups.
 #pragma once
 #include <benchmark/benchmark.h>

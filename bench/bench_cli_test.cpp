@@ -1,4 +1,4 @@
-// `rayaudit bench` run as a user would (issue 13): the JSON of a small
+// `rayaudit bench` run as a user would: the JSON of a small
 // --quick subset holds every group with the names and counters the issue
 // fixes, and bad input is one line, exit 2, nothing written. No timings are
 // asserted (those belong in the benchmark's output).
@@ -209,7 +209,7 @@ TEST(BenchCli, OtherArgumentsAreRefused) {
 }
 
 // Google Benchmark flags with bad values: one line naming the flag, exit 2,
-// before anything runs (HOSTILE2 F34: a negative count was "vector::reserve"
+// before anything runs (a negative count was "vector::reserve"
 // exit 1, an unknown format printed the usage text with exit 0).
 TEST(BenchCli, BadBenchmarkFlagValuesAreRefused) {
   expect_refused("--benchmark_repetitions=-5", "--benchmark_repetitions: \"-5\" is not a whole number");
@@ -221,8 +221,8 @@ TEST(BenchCli, BadBenchmarkFlagValuesAreRefused) {
   expect_refused("--benchmark_bogus=1", "--benchmark_bogus: \"1\" is not a Google Benchmark flag");
 }
 
-// Listing runs nothing: with --json the old file stayed 0 bytes (HOSTILE2
-// F33); now refused and the old file untouched. Without --json it lists.
+// Listing runs nothing: with --json the old file stayed 0 bytes;
+// now refused and the old file untouched. Without --json it lists.
 TEST(BenchCli, ListTestsNeverTouchesTheJson) {
   const fs::path out = temp_json("listed.json");
   std::ofstream(out) << "PRECIOUS\n";
@@ -239,7 +239,7 @@ TEST(BenchCli, ListTestsNeverTouchesTheJson) {
   EXPECT_NE(l.out.find("kernel/moller/float/nocull/hit=50/back=0"), std::string::npos) << l.out;
 }
 
-// --json naming a corpus mesh the run reads (HOSTILE2 F36: it was replaced).
+// --json naming a corpus mesh the run reads (it was replaced).
 TEST(BenchCli, JsonThatIsACorpusInputIsRefused) {
   const fs::path cache = fs::temp_directory_path() / ("rayaudit-bench-cache-" + std::to_string(::getpid()));
   fs::create_directories(cache / "corpus" / "ladder");
@@ -257,7 +257,7 @@ TEST(BenchCli, JsonThatIsACorpusInputIsRefused) {
   fs::remove_all(cache);
 }
 
-// A full disk: exit 2 with one line, the old JSON kept (HOSTILE2 F35: exit
+// A full disk: exit 2 with one line, the old JSON kept (exit
 // 0 and a truncated JSON in its place). Google Benchmark's JSON is held in
 // memory and written with every write checked.
 TEST(BenchCli, FullDiskKeepsTheOldJson) {
@@ -277,7 +277,7 @@ TEST(BenchCli, FullDiskKeepsTheOldJson) {
 
 }  // namespace
 
-// HOSTILE2 F35: on a full disk Google Benchmark's writer cut the JSON short
+// On a full disk Google Benchmark's writer cut the JSON short
 // and it replaced the previous file, exit 0. Root only (a 64 KiB tmpfs).
 TEST(BenchCli, FullDiskKeepsThePreviousJson) {
   ra::test::FullDisk disk(1024);

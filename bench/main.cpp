@@ -1,4 +1,4 @@
-// rayaudit-bench (issue 13), run as `rayaudit bench`: every group registered,
+// rayaudit-bench, run as `rayaudit bench`: every group registered,
 // the arguments checked before anything runs (one line and exit 2 on bad
 // input, nothing written), then Google Benchmark, whose JSON is kept in
 // memory and written atomically to --json OUT only when every row succeeded.
@@ -118,7 +118,7 @@ bool option(int argc, char** argv, int& i, const char* name, std::string& value)
 
 // Google Benchmark's own flags, checked here because its parser prints
 // several lines, usage text with exit 0, or throws (a negative repetition
-// count: "vector::reserve") on a bad value (HOSTILE2 F34). The bounds keep a
+// count: "vector::reserve") on a bad value. The bounds keep a
 // run finite: at most 1000 repetitions, at most 60 s a row.
 bool gb_bool(const std::string& v) {
   static const std::set<std::string> ok{"", "true", "false", "yes", "no", "1", "0", "t", "f", "y", "n",
@@ -220,7 +220,7 @@ Args parse_args(int argc, char** argv) {
     }
   }
   // Listing runs nothing, so there would be no JSON: replacing OUT with an
-  // empty file (HOSTILE2 F33) is refused rather than done.
+  // empty file is refused rather than done.
   if (!a.json.empty() && lists_tests(a.passthrough))
     throw ra::InputError("--benchmark_list_tests: lists the rows and runs none, so there is no JSON; drop --json");
   return a;
@@ -269,7 +269,7 @@ void check_selection(const Args& a) {
     std::error_code ec;
     if (!fs::is_regular_file(p, ec))
       throw ra::InputError(ra::located(p.string(), 0, "missing from the mesh corpus: ci/fetch-corpus.sh fetches it"));
-    ra::note_input(p);  // --json naming a corpus mesh is refused (HOSTILE2 F36)
+    ra::note_input(p);  // --json naming a corpus mesh is refused
   }
   // A peer that is not installed is an error, not a skip (Embree,
   // tinyobjloader and CGAL are linked in: without them there is no program).
@@ -278,7 +278,7 @@ void check_selection(const Args& a) {
 
 // Google Benchmark's JSON, kept in memory and written with
 // write_text_atomically at the end: its own file writer does not report a
-// full disk (HOSTILE2 F35: exit 0 and a truncated JSON in place of the old
+// full disk (exit 0 and a truncated JSON in place of the old
 // file). Google Benchmark hands a file reporter the stream of
 // --benchmark_out (set to /dev/null); this one forwards to a JSONReporter
 // writing into a string instead.

@@ -1,7 +1,7 @@
 // Group oracle/FAMILY/threads=T: throughput of the exact oracle
 // (validation/exact/oracle.h) on every case family of the audit
 // (validation/exact/families.h), in double: cases per second as a rate counter
-// (issue 6 asks 2 million cases/s with 2 threads) and the share of cases
+// (the audit's target: 2 million cases/s with 2 threads) and the share of cases
 // that needed exact arithmetic.
 #include <benchmark/benchmark.h>
 

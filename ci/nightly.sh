@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The nightly differential job of issue 18, one command: install what is
+# The nightly differential job against POV-Ray, one command: install what is
 # missing, build, then compare POV-Ray 3.7 with our tracer on random scenes
 # (`rayaudit compare --random N --seed S --out DIR`, every differing pixel
 # explained, each unexplained one shrunk to a minimal scene in DIR) for

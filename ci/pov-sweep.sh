@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The corpus sweep of issue 18: every OBJ in the corpus cache (ladder/,
+# The POV-Ray differential sweep of the corpus: every OBJ in the corpus cache (ladder/,
 # assimp-obj/, embree/) rendered as a bare .obj scene (the defaults: camera
 # framing it, a light at the camera, 320 x 240) with our tracer and with
 # POV-Ray 3.7, and every differing pixel explained (`rayaudit compare

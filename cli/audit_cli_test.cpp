@@ -1,5 +1,6 @@
 // Tests of `rayaudit audit` run as a user would (cli/cmd_audit.cpp): exit
-// codes, the --cases JSON shape, malformed input, export round trip, determinism.
+// codes, the --cases JSON shape, malformed input, export round trip, determinism;
+// --export-cases in one precision, streamed, safe on a full disk; merge's checks.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -17,12 +18,15 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "registry.h"
+#include "io/full_disk.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using namespace ra::test;
 
 struct Result {
   int code;
@@ -33,13 +37,6 @@ fs::path tmp(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("rayaudit_cli_audit_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir / name;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 Result rayaudit(const std::string& args) {
@@ -279,7 +276,7 @@ TEST(AuditShards, MergingShardsOfDifferentRunsIsAnErrorNamingBothFiles) {
   EXPECT_EQ(rayaudit(run + " --shard 1").code, 2);
 }
 
-// Hostile shards (issue 15's third pass): a count near 2^64 wrapped when
+// Hostile shards: a count near 2^64 wrapped when
 // merged, a shard count of 4e9 was a bad_alloc, a key given twice was
 // resolved silently, a directory was a raw library error.
 TEST(AuditShards, HostileShardsAreOneLineErrors) {
@@ -443,7 +440,7 @@ TEST(AuditGrade, NonFiniteTIsWrongAndFloatCasesAreRounded) {
 
 // Answers as spreadsheets save them: a UTF-8 BOM is dropped (it read
 // "missing column 'id'"); UTF-16 is named; a directory or FIFO as answers is
-// named, not read as "empty file" or waited on (issue 15's third pass).
+// named, not read as "empty file" or waited on.
 TEST(AuditGrade, AnswersEncodingAndNonFilesAreNamed) {
   const fs::path cases = tmp("ge_cases.csv"), answers = tmp("ge_answers.csv"), json = tmp("ge.json");
   write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\na,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
@@ -492,7 +489,7 @@ long peak_rss_kb(const std::vector<std::string>& args) {
   return ru.ru_maxrss;
 }
 
-// Issue 15: `audit --cases` held every row and its JSON (175x the CSV). Now
+// `audit --cases` held every row and its JSON (175x the CSV). Now
 // streamed: 100k rows peak where 20k do (the old code grew ~3 kB per row).
 TEST(AuditCli, CasesMemoryDoesNotGrowWithRows) {
 #if defined(__SANITIZE_ADDRESS__)
@@ -513,6 +510,97 @@ TEST(AuditCli, CasesMemoryDoesNotGrowWithRows) {
   EXPECT_LT(b, a + 25 * 1024) << "20k rows: " << a << " kB, 100k rows: " << b << " kB";
   EXPECT_EQ(nlohmann::json::parse(slurp(json))["cases"].size(), 100000u);
   fs::remove(small), fs::remove(large), fs::remove(json);
+}
+
+// A list of two precisions was taken as double, the float half dropped.
+TEST(AuditExportCli, ExportCasesTakesOnePrecision) {
+  const fs::path out = scratch("two-precisions.csv");
+  fs::remove(out);
+  for (const char* list : {"float,double", "double,float"}) {
+    const auto r = run_rayaudit("audit --export-cases " + out.string() + " --precision " + list + " --rays 10");
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_EQ(r.err, std::string("--precision: --export-cases takes one precision (float or double), got '") + list +
+                         "'\n");
+    EXPECT_FALSE(fs::exists(out));
+  }
+  const auto ok = run_rayaudit("audit --export-cases " + out.string() + " --precision float --rays 10 --families edge");
+  EXPECT_EQ(ok.code, 0) << ok.all;
+  EXPECT_NE(ok.out.find("float cases"), std::string::npos) << ok.out;
+}
+
+// The export held every case in memory (840 bytes each: 300,000 cases
+// did not fit in 200 MB of address space); it streams now.
+TEST(AuditExportCli, ExportCasesStreamsWithinAFixedAddressSpace) {
+  RAYAUDIT_SKIP_IF_SANITIZED();
+  const fs::path out = scratch("streamed.csv");
+  const auto r = run_rayaudit("audit --export-cases " + out.string() + " --rays 300000 --families random --precision double",
+                              "prlimit --as=200000000");
+  ASSERT_EQ(r.code, 0) << r.all;
+  EXPECT_NE(r.out.find("wrote 300000 double cases"), std::string::npos) << r.out;
+  std::ifstream in(out);
+  long lines = 0;
+  for (std::string l; std::getline(in, l);) ++lines;
+  EXPECT_EQ(lines, 300001);
+  fs::remove(out);
+}
+
+// Impossible counts and unknown keys in a shard were merged as given;
+// a hostile shard was held at ~30x its size (a bare std::bad_alloc).
+TEST(AuditShards, MergeRefusesImpossibleStatsUnknownKeysAndHugeShards) {
+  const fs::path sh1 = scratch("sh1.json"), sh2 = scratch("sh2.json"), out = scratch("merged.json");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 1/2 --json " + sh1.string()).code, 0);
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 2/2 --json " + sh2.string()).code, 0);
+  const std::string text = slurp(sh1);
+  auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+    return scratch_variant(text, name, from, to);
+  };
+  // false_hits 1000 in a cell of 10 tests (the number replaced in place).
+  const fs::path false_hits = scratch("m-false-hits.json");
+  std::string fh = text;
+  const auto at = fh.find("\"false_hits\": ");
+  const auto end = fh.find(',', at);
+  fh.replace(at, end - at, "\"false_hits\": 1000");
+  std::ofstream(false_hits) << fh;
+  struct Case {
+    fs::path file;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {false_hits, ": cells[0].stats: the verdict counts add up to "},
+      {variant("m-unknown.json", "\"tests\": ", "\"zz\": 1, \"tests\": "), ": cells[0].stats: 'zz': unknown key"},
+      {variant("m-hist.json", "\"t_rel\": ", "\"zz\": [], \"t_rel\": "), ": cells[0].histograms: 'zz': unknown key"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_rayaudit("audit merge " + c.file.string() + " " + sh2.string() + " --json " + out.string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find(c.file.string() + c.message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // 9 MB of JSON (spaces are JSON too): refused by its size, before parsing.
+  const fs::path big = scratch("m-big.json");
+  std::ofstream(big) << text.substr(0, text.size() - 2) << std::string(9u << 20, ' ') << "}\n";
+  const auto r = run_rayaudit("audit merge " + big.string() + " " + sh2.string() + " --json " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, big.string() + ": 9 MB is larger than a shard can be (at most 8 MB; a full audit's shard is about 1 MB)\n");
+  EXPECT_FALSE(fs::exists(out));
+  // The untouched shards still merge.
+  EXPECT_EQ(run_rayaudit("audit merge " + sh1.string() + " " + sh2.string() + " --json " + out.string()).code, 0);
+}
+
+// The streamed export on a full disk: one line, exit 2, the old file kept
+// (the rows now go to the file as they are made; the write is still checked
+// through close and rename).
+TEST(AuditExportCli, StreamedExportOnAFullDiskKeepsTheOldFile) {
+  ra::test::FullDisk disk;
+  if (!disk.ok()) GTEST_SKIP() << disk.why_not();
+  const fs::path out = disk.dir() / "cases.csv";
+  std::ofstream(out) << "good";
+  const auto r = run_rayaudit("audit --export-cases " + out.string() + " --families edge --rays 1000");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find(out.string() + ": cannot write"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out), "good");
 }
 
 }  // namespace

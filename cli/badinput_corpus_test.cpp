@@ -1,4 +1,4 @@
-// The bad-input corpus (cli/badinput/, issue 15): every file is run through
+// The bad-input corpus (cli/badinput/): every file is run through
 // the real rayaudit by the command that reads its kind, in a child process
 // with its address space and CPU time limited. Each must give exit 2, one
 // stderr line naming the file and its expected message (cli/badinput/

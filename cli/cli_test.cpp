@@ -21,15 +21,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out;  // stdout and stderr
-};
-
-Result run(const std::string& args) {
-  const auto r = ra::test::run_rayaudit(args);
-  return {r.code, r.all};
-}
+using ra::test::Result;
+using ra::test::run;
 
 fs::path temp_dir() {
   fs::path d = fs::temp_directory_path() / ("rayaudit-cli-" + std::to_string(::getpid()));
@@ -71,7 +64,7 @@ TEST(Cli, BadSceneExits2WithFileAndPath) {
   EXPECT_FALSE(fs::exists(dir / "bad.png"));
 }
 
-// The method names of issue 3, by kind: the CLI's names are a contract.
+// The documents' method names and the modern references', by kind: the CLI's names are a contract.
 const std::vector<std::string> kTriangleMethods = {"angles", "cramer", "areas", "triple",
                                                    "sameside", "moller", "watertight", "baldwin"};
 const std::vector<std::string> kSphereMethods = {"kraus", "codeproject", "codeproject-fixed", "stable"};

@@ -214,7 +214,7 @@ std::function<void(std::uint64_t, std::uint64_t)> progress_reporter() {
 // ---------------------------------------------------------- --cases ---
 nlohmann::json t_json(double t) { return std::isfinite(t) ? nlohmann::json(t) : nlohmann::json(nullptr); }
 
-// Streams the cases (issue 15: memory independent of the number of rows):
+// Streams the cases (memory independent of the number of rows):
 // a first pass validates the whole file, so bad input prints and writes
 // nothing; the second grades row by row, printing the table and writing the
 // JSON (byte for byte what nlohmann's dump(2) of the whole document gives).
@@ -329,7 +329,7 @@ void export_cases(const Args& a) {
     throw ra::InputError("--rays: " + std::to_string(a.rays) + " is above the export's limit of " +
                          std::to_string(kMaxExportRays) + " cases per family (about 350 bytes each on disk)");
   const auto precisions = chosen_precisions(a.precision);
-  // One file holds one precision's inputs (HOSTILE2 F1: a list of two was
+  // One file holds one precision's inputs (a list of two was
   // taken as double and the float half dropped silently).
   if (a.precision_given && precisions.size() != 1)
     throw ra::InputError("--precision: --export-cases takes one precision (float or double), got '" + a.precision + "'");
@@ -433,7 +433,7 @@ void audit(const Args& a) {
 // ------------------------------------------------------------ merge ---
 // One shard as merge needs it: its report and what must agree between the
 // shards of one run; the parsed JSON is dropped once read, and shards are
-// read one at a time (HOSTILE2 F26: every shard's JSON was held at ~30x its
+// read one at a time (every shard's JSON was held at ~30x its
 // size; 191 MB ended in a bare std::bad_alloc).
 struct ShardFile {
   std::string path;

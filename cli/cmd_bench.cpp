@@ -1,5 +1,5 @@
-// `rayaudit bench [--quick] [--json OUT] [--threads N] [--filter REGEX] [--runs N]`
-// (issue 13): checks what it can cheaply, then runs rayaudit-bench (built
+// `rayaudit bench [--quick] [--json OUT] [--threads N] [--filter REGEX] [--runs N]`:
+// checks what it can cheaply, then runs rayaudit-bench (built
 // beside rayaudit), which holds Google Benchmark, Embree, tinyobjloader and
 // CGAL's AABB tree so that this program does not load them at every start.
 #include <unistd.h>

@@ -8,7 +8,7 @@
 // --explain then names our models' causes where that image agrees with our
 // render (validation/images/their_image.h says which images are taken).
 //
-// `rayaudit compare --random N --seed S [--out DIR]` (issue 18) does the same
+// `rayaudit compare --random N --seed S [--out DIR]` does the same
 // on N random scenes (validation/pov/random_scene.h), explaining every differing
 // pixel; a pixel no known cause explains is shrunk to a minimal scene
 // (validation/pov/pov_shrink.h) written to DIR. Exit 1 if any remain.
@@ -81,7 +81,7 @@ void run_random(const Args& a) {
   if (!a.out_dir.empty()) {
     std::error_code ec;
     // One level, as every other command's output directory: a missing
-    // parent is a mistyped path, not something to create (issue 15).
+    // parent is a mistyped path, not something to create.
     if (!fs::is_directory(fs::absolute(a.out_dir).parent_path()))
       throw ra::InputError(a.out_dir + ": its parent directory does not exist");
     fs::create_directory(a.out_dir, ec);
@@ -186,7 +186,7 @@ void run(const Args& a) {
       throw ra::cli::ExitCode{kSkipped};
     }
   // Image formats checked with the other destination checks, before both
-  // renders (HOSTILE2 F44: found only after minutes of POV-Ray).
+  // renders (found only after minutes of POV-Ray).
   for (const std::string* out : {&a.diff_out, &a.ours_out, &a.pov_out}) {
     std::string ext = std::filesystem::path(*out).extension().string();
     for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
@@ -195,7 +195,7 @@ void run(const Args& a) {
   }
   ra::OutputBatch outputs({a.json_out, a.diff_out, a.ours_out, a.pov_out});
   // Image outputs' formats with the other destination checks, before both
-  // renders (x.jpg failed after them: minutes of POV-Ray lost; HOSTILE2 F44).
+  // renders (x.jpg failed after them: minutes of POV-Ray lost).
   for (auto [flag, path] : {std::pair{"--diff", &a.diff_out}, {"--ours", &a.ours_out}, {"--pov", &a.pov_out}}) {
     std::string ext = std::filesystem::path(*path).extension().string();
     for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
@@ -224,7 +224,7 @@ void run(const Args& a) {
   const ra::PovTolerance tol =
       ra::load_pov_tolerance(a.tolerance.empty() ? ra::pov_tolerance_path(a.scene) : std::filesystem::path(a.tolerance));
   // A tolerance file named on the command line is for this image: one for
-  // 16x16 silently judged nothing of an 8x8 render (HOSTILE2 F21). The
+  // 16x16 silently judged nothing of an 8x8 render. The
   // scene's default file keeps its note ("for WxH, not this size: none
   // apply"), so compare at another --width still runs.
   if (!a.tolerance.empty())

@@ -69,7 +69,7 @@ constexpr double kMaxPixelMaps = 16777216;
 std::filesystem::path default_ladder_mesh() { return ra::cache_dir() / "corpus" / "ladder" / "elephant_cgal.obj"; }
 
 // Progress: redrawn in place on a terminal; otherwise (CI logs) a line
-// every 10 s with an estimate of the rest, as audit prints (HOSTILE2 F38:
+// every 10 s with an estimate of the rest, as audit prints (it was
 // silent for hours), so a long run shows it is alive and how long it has.
 std::function<void(std::size_t, std::size_t)> progress_count() {
   using clock = std::chrono::steady_clock;
@@ -106,7 +106,7 @@ void run(const Args& a) {
   if (!std::filesystem::is_directory(parent)) throw ra::InputError(a.out + ": its parent directory does not exist");
 
   // Absurd work is refused up front with its size, before any mesh is read
-  // (HOSTILE2 F38: the flags' own limits allowed ~34 hours, silently). A
+  // (the flags' own limits allowed ~34 hours, silently). A
   // pixel of a map costs tens of microseconds (a closed mesh far from the
   // origin, and the oracle).
   {
@@ -129,13 +129,13 @@ void run(const Args& a) {
     ra::note_input(f);
   }
   // Each --mesh is an input: a map named like it is refused, not written
-  // over it (HOSTILE2 F22).
+  // over it.
   for (const auto& m : a.meshes) {
     meshes.push_back(ra::crack::closed_obj(m));
     ra::note_input(m);
   }
 
-  // Every output named and checked before the work (issue 15: a name too
+  // Every output named and checked before the work (a name too
   // long failed after it, leaving one map; a --mesh named sphere.obj shared
   // the built-in sphere's names and one of each pair was lost).
   std::vector<std::filesystem::path> outputs{dir / "crack_maps.json"};

@@ -58,7 +58,7 @@ struct LineOf {
 };
 
 // One number of a vector: all of the text a decimal number, finite and
-// within the scene limit (HOSTILE2 F43: 1e400 was a bare "stod").
+// within the scene limit (1e400 was a bare "stod").
 double inc_number(const std::string& file, long line, std::string s) {
   const auto b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
   s = b == std::string::npos ? "" : s.substr(b, e - b + 1);
@@ -71,8 +71,8 @@ double inc_number(const std::string& file, long line, std::string s) {
 }
 
 // The bicubic_patch blocks of teapot.inc: each `{ ... }` closed and holding
-// exactly 16 vectors <x, y, z>; anything else named with its line (HOSTILE2
-// F43: 20 points, an unclosed brace and <1,2> were accepted).
+// exactly 16 vectors <x, y, z>; anything else named with its line
+// (20 points, an unclosed brace and <1,2> were accepted).
 std::vector<Patch> read_teapot_inc(const std::string& file) {
   ra::check_input_file(file);  // /dev/zero, a FIFO or a directory named, not read
   std::ifstream in(file);
@@ -136,8 +136,8 @@ constexpr double kMaxTeapotTriangles = 1 << 20;
 void generate_teapot(const std::string& inc, const std::string& out_path, int steps) {
   ra::declare_output(out_path);
   const auto patches = read_teapot_inc(inc);
-  // The size of the work from the file and --steps, before it (HOSTILE2 F43:
-  // a 327 KB .inc at --steps 256 took 2.6 GB, a 32 MB one 16.8 GB).
+  // The size of the work from the file and --steps, before it
+  // (a 327 KB .inc at --steps 256 took 2.6 GB, a 32 MB one 16.8 GB).
   const double triangles = 2.0 * double(patches.size()) * steps * steps;
   if (triangles > kMaxTeapotTriangles)
     throw ra::InputError(ra::located(inc, 0, std::to_string(patches.size()) + " patches at --steps " +
@@ -179,7 +179,7 @@ void generate_teapot(const std::string& inc, const std::string& out_path, int st
         while (u - centre_u > 0.5) u -= 1;
         while (u - centre_u < -0.5) u += 1;
         // All patches at one height (ymax = ymin): v = 0, not 0/0 = NaN,
-        // which our own OBJ reader then refused (hostile pass).
+        // which our own OBJ reader then refused.
         uvs.push_back({u * kTurns, ymax > ymin ? (q.y - ymin) / (ymax - ymin) : 0.0});
         vid[j * (steps + 1) + i] = vertex(q);
         pos[j * (steps + 1) + i] = q;
@@ -306,7 +306,7 @@ void setup(CLI::App& app) {
   tp->add_option("-o,--output", *out, "Output .obj")->required();
   tp->add_option("--steps", *steps, "Quads per patch side (default 8)")->check(CLI::Range(1, 256));
   tp->callback([=] {
-    // As convert: an OBJ named .png was written without a word (hostile pass).
+    // As convert: an OBJ named .png was written without a word.
     const std::string ext = std::filesystem::path(*out).extension().string();
     if (ext != ".obj" && ext != ".OBJ") throw ra::InputError(*out + ": the output must be a .obj file");
     generate_teapot(*inc, *out, *steps);

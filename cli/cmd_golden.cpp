@@ -42,7 +42,7 @@ std::vector<std::string> names_of(const std::vector<std::string>& given, const r
     const bool plain = !p.is_absolute() && rel.find("..") == std::string::npos;
     if (!plain) {
       // A path elsewhere was checked as ROOT/scenes/<its stem>.json, and that
-      // file named in the error (HOSTILE2 F23): a path must be under scenes/.
+      // file named in the error: a path must be under scenes/.
       std::error_code ec;
       const std::filesystem::path scenes = std::filesystem::weakly_canonical(set.root() / "scenes", ec);
       const std::filesystem::path under = std::filesystem::weakly_canonical(p, ec).lexically_relative(scenes);
@@ -146,7 +146,7 @@ void check(Args a) {
     throw ra::InputError((std::filesystem::path(a.root) / "golden" / "manifest.json").string() +
                          ": no golden images to check");
   // A name that is neither a scene nor a golden is refused before any render
-  // (it was found after rendering the others; hostile pass). A golden whose
+  // (it was found after rendering the others). A golden whose
   // scene is gone is a failed check, reported in its turn.
   {
     const auto known = set.all_names();  // sorted: scenes/ and the manifest's entries
@@ -243,7 +243,7 @@ void check(Args a) {
 
 // Every scene is rendered before anything is renamed into golden/: a scene
 // that fails (exit 2) leaves every golden and the manifest as they were
-// (`bless A BAD` rewrote A's image, its manifest entry stale: issue 15).
+// (`bless A BAD` rewrote A's image, its manifest entry stale).
 void bless(Args a) {
   check_root(a);
   ra::OutputBatch outputs({});

@@ -30,7 +30,7 @@ void setup(CLI::App& app) {
     ra::ObjOptions opt;
     opt.threads = o->threads;
     // A PLY, OFF or scene JSON read as an OBJ of unknown statements: an
-    // empty mesh and exit 0 (HOSTILE2 F32); render refuses them by name.
+    // empty mesh and exit 0; render refuses them by name.
     std::string ext = std::filesystem::path(o->file).extension().string();
     for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     if (ext == ".ply" || ext == ".off" || ext == ".json")

@@ -10,14 +10,8 @@
 
 namespace {
 
-struct Result {
-  int code;
-  std::string out;  // stdout and stderr
-};
-Result run(const std::string& args) {
-  const auto r = ra::test::run_rayaudit(args);
-  return {r.code, r.all};
-}
+using ra::test::Result;
+using ra::test::run;
 
 TEST(CliInfo, JsonFields) {
   ra::test::TempDir d;

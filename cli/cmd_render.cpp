@@ -124,7 +124,7 @@ void run(const Args& a) {
   // POV-Ray's windows (the default) drop hits nearer than 1e-4 and shadow
   // blockers within 1e-3 of a point: a scene a few thousandths across then
   // renders black or unshadowed, which exited 0 without a word (a 1e-5
-  // quad as a bare .obj; hostile pass).
+  // quad as a bare .obj).
   if (opt.self_intersection == ra::SelfIntersection::pov) {
     const double r = ra::scene_bounds(scene).radius;
     if (r > 0 && r < 1e-2)

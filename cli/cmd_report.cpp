@@ -1,4 +1,4 @@
-// `rayaudit report`: the main job's product (issue 14). Checks every input
+// `rayaudit report`: the main job's product. Checks every input
 // here, then validation/report/report.py (matplotlib) draws the page.
 #include <sys/wait.h>
 #include <unistd.h>
@@ -120,7 +120,7 @@ void check_audit(const fs::path& f) {
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const std::string at = "cells[" + std::to_string(i) + "]";
     for (const char* k : {"subject", "family", "param", "sweep"}) need(f, cells[i], at, k, "string");
-    // The page splits the subject at its last '/' (HOSTILE2 F25: a subject
+    // The page splits the subject at its last '/' (a subject
     // without one, or a negative count, ended in a Python traceback).
     const std::string subject = cells[i]["subject"].get<std::string>();
     const std::size_t slash = subject.rfind('/');
@@ -227,7 +227,7 @@ void check_stages(const fs::path& f) {
         end == line.c_str() + tab + 1)
       throw ra::InputError(ra::located(f.string(), n, "expected STAGE<TAB>SECONDS"));
     // Decimal only: strtod also takes C99 hex ("0x10"), which the page's
-    // Python float() refuses (HOSTILE2 F25).
+    // Python float() refuses.
     if (line.find_first_not_of("0123456789.eE+-", tab + 1) != std::string::npos)
       throw ra::InputError(ra::located(f.string(), n, "seconds '" + line.substr(tab + 1, 40) + "' is not a decimal number"));
     // nan, a negative time or 1e400 (inf) were drawn as given.
@@ -325,8 +325,8 @@ void run(const Args& a) {
                       {"version", std::string("rayaudit ") + RAYAUDIT_VERSION}}},
                     {"out_dir", tmp.string()}};
   // JSON strings are UTF-8, file names are bytes: the paths again, as hex
-  // of their bytes, which the script decodes with os.fsdecode (HOSTILE2 F31:
-  // a Latin-1 directory name could not be opened from the context).
+  // of their bytes, which the script decodes with os.fsdecode
+  // (a Latin-1 directory name could not be opened from the context).
   json fs_paths = json::object();
   for (const char* k : {"audit", "crack_maps", "golden", "stages", "out_dir"})
     if (ctx.at(k).is_string()) fs_paths[k] = hex_bytes(k == std::string("out_dir") ? tmp.string() :

@@ -25,7 +25,7 @@ std::vector<Command>& commands();
 // "a, b,c" -> {"a", "b", "c"}: the comma-separated lists of options such
 // as --methods, --families and --offsets (spaces dropped). An empty item
 // ("a,,b", "a,", ",") is an error naming `flag`: it was dropped silently,
-// and `--methods ,` meant every method (issue 15).
+// and `--methods ,` meant every method.
 inline std::vector<std::string> split_list(const std::string& s, const char* flag) {
   std::vector<std::string> out;
   if (s.find_first_not_of(' ') == std::string::npos) return out;  // not given

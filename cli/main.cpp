@@ -34,7 +34,7 @@ void refuse_empty_values(CLI::App& app) {
 }
 
 // What a command printed must have arrived: `info --json > f` on a full
-// disk exited 0 and left f empty (hostile pass). Both streams are flushed
+// disk exited 0 and left f empty. Both streams are flushed
 // and checked before a success is reported.
 int finish(int code) {
   errno = 0;

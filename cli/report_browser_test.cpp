@@ -1,4 +1,4 @@
-// The report in a real browser (issue 14): a report from a real small run
+// The report in a real browser: a report from a real small run
 // opens in headless Chromium with every image and chart drawn, no console error.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -15,14 +15,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using ra::test::run_rayaudit;
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using namespace ra::test;
 
 // Runs a command, returning its exit code and putting stdout + stderr in `out`.
 int sh(const std::string& cmd, std::string& out) {

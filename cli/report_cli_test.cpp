@@ -1,5 +1,7 @@
-// `rayaudit report` and `rayaudit crack-maps` (issue 14): bad input is one line
-// and exit 2 with nothing written; crack maps' counts match their images.
+// `rayaudit report` and `rayaudit crack-maps`: bad input is one line
+// and exit 2 with nothing written (what the page cannot draw, a byte-order
+// mark, an unreadable image, an output that is an input, absurd work);
+// crack maps' counts match their images.
 // The browser test is report_browser_test.cpp.
 #include <gtest/gtest.h>
 
@@ -7,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "image.h"
 #include "run_rayaudit.h"
@@ -14,20 +17,13 @@
 namespace {
 
 namespace fs = std::filesystem;
-using ra::test::run_rayaudit;
+using namespace ra::test;
 
 fs::path fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("rayaudit-report-test-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
-}
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
@@ -223,6 +219,203 @@ TEST(CrackMapsCli, NoLeakNearTheOriginAndRedPixelsAreTheLeaks) {
     EXPECT_EQ(red, m["leaks"].get<long long>()) << m;
   }
   fs::remove_all(d);
+}
+
+// crack-maps names every map before the work: a --mesh named like the
+// built-in sphere would share its maps' names (one of each pair lost), and a
+// name longer than the file system takes failed after the work, leaving a
+// partial directory. Both are refused first, and no directory is left.
+TEST(CrackMapsCli, CrackMapsRefusesCollidingAndOverlongNamesBeforeTheWork) {
+  const fs::path d = scratch_dir("crack-names");
+  const std::string tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  std::ofstream(d / "sphere.obj") << tetra;
+  const std::string long_stem(248, 'm');
+  std::ofstream(d / (long_stem + ".obj")) << tetra;
+  const std::string cm = (d / "cm").string();
+  const auto a = run_rayaudit("crack-maps -o " + cm + " --methods moller --offsets 1 --size 8 --mesh " +
+                              (d / "sphere.obj").string());
+  EXPECT_EQ(a.code, 2) << a.all;
+  EXPECT_TRUE(one_line(a.err)) << a.err;
+  EXPECT_NE(a.err.find("sphere-moller-1.png: two maps would have this name"), std::string::npos) << a.err;
+  const auto b = run_rayaudit("crack-maps -o " + cm + " --methods moller --offsets 1 --size 8 --mesh " +
+                              (d / (long_stem + ".obj")).string());
+  EXPECT_EQ(b.code, 2) << b.all;
+  EXPECT_TRUE(one_line(b.err)) << b.err;
+  EXPECT_NE(b.err.find("file name too long"), std::string::npos) << b.err;
+  EXPECT_FALSE(fs::exists(cm)) << "left behind";
+}
+
+// report: its audit input named as its report.json output is refused before
+// the script runs; stage times of nan, -5 or with a NUL are refused at their
+// line (they were drawn, or failed as a Python traceback).
+TEST(ReportCli, ReportRefusesItsInputAsOutputAndBadStageTimes) {
+  const fs::path d = scratch("report-in-out");
+  fs::remove_all(d);
+  fs::create_directories(d / "rep");
+  const fs::path audit = d / "rep" / "report.json";
+  ASSERT_EQ(run_rayaudit("audit --rays 50 --families edge --methods moller --json " + audit.string()).code, 0);
+  const std::string before = slurp(audit);
+  auto r = run_rayaudit("report --audit " + audit.string() + " -o " + (d / "rep").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, audit.string() + ": is also an input of this command (" + audit.string() +
+                       "): it would be replaced; choose another output\n");
+  EXPECT_EQ(slurp(audit), before);
+  EXPECT_FALSE(fs::exists(d / "rep" / "index.html"));
+  for (const std::string& stage : {std::string("build\tnan\n"), std::string("build\t-5\n"), std::string("build\t1\0x\n", 10)}) {
+    std::ofstream(d / "st.tsv", std::ios::binary) << stage;
+    r = run_rayaudit("report --audit " + audit.string() + " --stages " + (d / "st.tsv").string() + " -o " +
+                     (d / "out").string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_EQ(r.err.rfind((d / "st.tsv").string() + ":1: ", 0), 0u) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(d / "out"));
+}
+
+// An OBJ read through its memory map was not noted as an
+// input, so `crack-maps --mesh` naming one of its own maps overwrote it.
+TEST(CrackMapsCli, CrackMapsMeshThatIsOneOfItsMapsIsRefused) {
+  const fs::path dir = scratch_dir("cm-mesh-input");
+  const fs::path mesh = dir / "sphere-moller-1.png";
+  fs::copy_file(kScenes + "/meshes/tetrahedron.obj", mesh);
+  const std::string before = slurp(mesh);
+  const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + mesh.string() +
+                              " --methods moller --offsets 1 --size 8");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("sphere-moller-1.png: is also an input of this command"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(mesh), before);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+  fs::remove_all(dir);
+}
+
+// An audit JSON with a UTF-8 BOM passed the C++ checks and
+// ended in a 13-line Python traceback; report.py reads it as utf-8-sig.
+TEST(ReportCli, ReportReadsAnAuditJsonWithABom) {
+  const fs::path dir = scratch_dir("report-bom");
+  const fs::path audit = dir / "a.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
+  std::ofstream(dir / "bom.json") << "\xEF\xBB\xBF" << slurp(audit);
+  const auto r = run_rayaudit("report --audit " + (dir / "bom.json").string() + " -o " + (dir / "rep").string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(dir / "rep" / "index.html"));
+  fs::remove_all(dir);
+}
+
+// An image beside a compare JSON that PIL cannot open ended
+// the report in a 13-line traceback; it is one line naming the image.
+TEST(ReportCli, ReportWithAnUnreadableCompareImageIsOneLine) {
+  const fs::path dir = scratch("report-f40");
+  fs::remove_all(dir);
+  fs::create_directories(dir / "cmp");
+  const fs::path audit = dir / "a.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
+  std::ofstream(dir / "cmp" / "x.json") << R"({"width": 8, "height": 8, "differing": 0, "identical": true, "differences": []})";
+  std::ofstream(dir / "cmp" / "x-pov.png") << "not a png\n";
+  const auto r = run_rayaudit("report --audit " + audit.string() + " --compare " + (dir / "cmp").string() + " -o " +
+                              (dir / "rep").string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_EQ(r.err.rfind((dir / "cmp" / "x-pov.png").string() + ": not a readable image (", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "rep"));
+  fs::remove_all(dir);
+}
+
+// A --mesh whose path is one of the maps was overwritten by that map.
+TEST(CrackMapsCli, CrackMapsMeshThatIsAnOutputIsRefused) {
+  const fs::path dir = scratch("cm-identity");
+  fs::create_directories(dir);
+  const fs::path mesh = dir / "sphere-moller-1.png";
+  fs::copy_file(kScenes + "/meshes/tetrahedron.obj", mesh, fs::copy_options::overwrite_existing);
+  const std::string before = slurp(mesh);
+  const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + mesh.string() +
+                              " --methods moller --offsets 1 --size 8");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find(mesh.string() + ": is also an input of this command"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(mesh), before);
+  EXPECT_FALSE(fs::exists(dir / "crack_maps.json"));
+}
+
+// The flags' own limits multiplied to ~34 hours, run silently.
+TEST(CrackMapsCli, CrackMapsAbsurdWorkIsRefusedWithItsSize) {
+  const fs::path dir = scratch("cm-absurd");
+  const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + kScenes +
+                              "/meshes/tetrahedron.obj --size 1024 --offsets 1,10,100,1000,1e4");
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_EQ(r.err, "crack-maps: 80 maps of 1024x1024 pixels are 83886080 pixels (about 104 core-minutes); the "
+                   "limit is 16777216: fewer --offsets or --methods, or a smaller --size\n");
+  EXPECT_FALSE(fs::exists(dir));
+}
+
+// Inputs the C++ checks let through ended in Python tracebacks.
+TEST(ReportCli, ReportRefusesWhatThePageCannotDrawInOneLine) {
+  const fs::path audit = scratch("rep-audit.json");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json " + audit.string()).code, 0);
+  const std::string text = slurp(audit);
+  auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
+    return scratch_variant(text, name, from, to);
+  };
+  struct Case {
+    fs::path file;
+    std::string extra, message;
+  };
+  const fs::path stages = scratch("hex.tsv");
+  std::ofstream(stages) << "a\t0x10\n";
+  const std::vector<Case> cases = {
+      {variant("rep-subject.json", "\"subject\": \"moller/float\"", "\"subject\": \"moller\""), "",
+       ": cells[0]: subject 'moller' is not METHOD/PRECISION"},
+      {variant("rep-negative.json", "\"tests\": ", "\"tests\": -5, \"was\": "), "", " is negative"},
+      {audit, " --stages " + stages.string(), "hex.tsv:1: seconds '0x10' is not a decimal number"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = scratch("rep-out");
+    const auto r = run_rayaudit("report --audit " + c.file.string() + c.extra + " -o " + out.string());
+    EXPECT_EQ(r.code, 2) << r.all;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// A UTF-8 byte-order mark before the audit JSON (the C++ check took it,
+// the script's json.load did not).
+TEST(ReportCli, ReportReadsAnAuditJsonWithAByteOrderMark) {
+  const fs::path audit = scratch("bom-audit.json"), out = scratch("bom-report");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json " + audit.string()).code, 0);
+  const std::string text = slurp(audit);
+  std::ofstream(audit, std::ios::binary) << "\xef\xbb\xbf" << text;
+  const auto r = run_rayaudit("report --audit " + audit.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 0) << r.all;
+  EXPECT_TRUE(fs::exists(out / "index.html"));
+  fs::remove_all(out);
+}
+
+// A corrupt or huge image beside a compare JSON ended in a PIL
+// traceback; now one line naming the image, exit 2, nothing written.
+TEST(ReportCli, ReportNamesAnUnreadableOrHugeImageInOneLine) {
+  const fs::path audit = scratch("img-audit.json"), dir = scratch("img-cmp");
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 50 --json " + audit.string()).code, 0);
+  fs::create_directories(dir);
+  std::ofstream(dir / "x.json") << R"({"width": 8, "height": 8, "differing": 0, "identical": true, "differences": []})";
+  std::ofstream(dir / "x-pov.png") << "not a png\n";
+  const fs::path out = scratch("img-report");
+  auto r = run_rayaudit("report --audit " + audit.string() + " --compare " + dir.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("x-pov.png: not a readable image"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // A PNG header declaring 16384 x 16384 (what compare --width 16384 writes):
+  // refused from its size, not decoded (PIL's bomb error was 15 lines).
+  std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x40\0\0\0\x40\0\x08\x02\0\0\0", 29);
+  png += "\x26\xaa\x87\xd3";  // the IHDR chunk's CRC (PIL checks it on opening)
+  png += std::string("\0\0\0\0IEND\xae\x42\x60\x82", 12);  // PIL reads the next chunk's header too
+  std::ofstream(dir / "x-pov.png", std::ios::binary) << png;
+  r = run_rayaudit("report --audit " + audit.string() + " --compare " + dir.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 2) << r.all;
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("x-pov.png: 16384x16384 is too large to show in the report"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace

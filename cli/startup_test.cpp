@@ -1,4 +1,5 @@
-// Issue 15: OpenImageIO (~260 libraries, 130 MB) is loaded only by commands
+// Start-up cost: every process started at 132 MB and 0.14-0.27 s, even
+// --version. OpenImageIO (~260 libraries, 130 MB) is loaded only by commands
 // that touch an image (renderer/image_module.h). The dynamic loader's own
 // log (LD_DEBUG=files) says which libraries a run mapped.
 #include <gtest/gtest.h>
@@ -13,19 +14,13 @@
 #include "run_rayaudit.h"
 
 namespace fs = std::filesystem;
-using ra::test::run_rayaudit;
+using namespace ra::test;
 
 namespace {
 
 const std::string kSource = RAYAUDIT_SOURCE_DIR;
 
 bool loads_oiio(const std::string& loader_log) { return loader_log.find("file=libOpenImageIO") != std::string::npos; }
-
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("rayaudit-startup-" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d / name;
-}
 
 TEST(Startup, CommandsWithoutImagesDoNotLoadOpenImageIO) {
   for (const std::string& args : std::vector<std::string>{"--version", "methods", "info " + kSource + "/scenes/meshes/quad.obj",

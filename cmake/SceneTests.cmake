@@ -9,7 +9,7 @@
 # triangles; about 1 s each per test, the bunny's pov/ test about 2 s and the
 # dragon's, 640 x 480, about 12 s) is checked too, named corpus/NAME; they
 # skip when ci/fetch-corpus.sh has not filled the cache. So do two corpus scenes
-# of issue 18: cornell-box (a pixel POV-Ray's mesh2 inside test decides) and
+# of the POV-Ray differential tests: cornell-box (a pixel POV-Ray's mesh2 inside test decides) and
 # spider-textured (POV's mesh2 UVs, hit point and float32 data).
 file(GLOB RAYAUDIT_SCENES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/scenes/*.json)
 foreach(rung ladder-10-box ladder-1k-teapot-npm ladder-10k-cheese-ball ladder-100k-bunny ladder-1M-dragon

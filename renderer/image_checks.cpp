@@ -69,14 +69,7 @@ ImageProblem pnm_problem(std::ifstream& in, std::uint64_t size) {
     return head.substr(i, e - i);
   };
   for (int f = 0; f < fields; ++f) {
-    for (;;) {  // whitespace and comments
-      while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) line += head[i++] == '\n';
-      if (i < head.size() && head[i] == '#') {
-        while (i < head.size() && head[i] != '\n') ++i;
-        continue;
-      }
-      break;
-    }
+    skip();
     std::uint64_t v = 0;
     const std::size_t b = i;
     while (i < head.size() && std::isdigit(static_cast<unsigned char>(head[i])) && i - b < 12) v = v * 10 + std::uint64_t(head[i++] - '0');

@@ -1,5 +1,5 @@
 // Checks of image files before OpenImageIO reads them, for what its readers
-// accept silently (issue 15's fourth pass): a PNG cut short after its pixel
+// accept silently: a PNG cut short after its pixel
 // data (no IEND), a PNM whose maxval is 0, and files that are no image at
 // all (text, a mesh, an empty file), which OIIO describes in its own words.
 #pragma once

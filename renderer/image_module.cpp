@@ -40,8 +40,8 @@ std::vector<std::string> candidates() {
 // they load, and some start threads in their initialisers (log4cplus: 4,
 // each with a stack and a malloc arena). Under an address-space limit
 // (`ulimit -v`, prlimit --as) that leaves less, the load or the first read
-// aborted, segfaulted or hung inside those libraries (410-450 MB: HOSTILE2
-// F28), and up to ~540 MB a valid texture's read failed as "cannot be
+// aborted, segfaulted or hung inside those libraries (410-450
+// MB), and up to ~540 MB a valid texture's read failed as "cannot be
 // allocated". Measured on Debian 12 (2 cores): an 8x8 textured render needs
 // about 525 MB beside the 10 MB mapped before; with a margin, 560 MB and a
 // thread stack (8 MB) a core beyond 2. Refused here, before dlopen.

@@ -1,4 +1,4 @@
-// Up-front memory estimate for image buffers (issue 15, "no unbounded
+// Up-front memory estimate for image buffers ("no unbounded
 // memory"): refused with a one-line estimate rather than a late bad_alloc.
 #include "memory_budget.h"
 

@@ -1,5 +1,5 @@
 // Memory an image-sized piece of work will need, checked before the work
-// (issue 15: a 16384x16384 render died of std::bad_alloc after 37 s).
+// (a 16384x16384 render died of std::bad_alloc after 37 s).
 #pragma once
 #include <cstdint>
 #include <string>

@@ -307,7 +307,7 @@ TEST(Texture, TgaWrittenByOiioSamplesTheHandWorkedTexels) {
   expect_hand_worked_tga_lookups(load_texture(file));
 }
 
-// Textures keep an 8- or 16-bit file's own values (issue 15: a 16384^2 1-bit
+// Textures keep an 8- or 16-bit file's own values (a 16384^2 1-bit
 // PNG took 1.24 GB as floats). Every level, grey and RGB, must read back bit
 // for bit as OpenImageIO's own float conversion of the same file gives it.
 TEST(Texture, EightAndSixteenBitTexelsAreOiiosFloatsBitForBit) {
@@ -348,7 +348,7 @@ TEST(Texture, EightAndSixteenBitTexelsAreOiiosFloatsBitForBit) {
     }
 }
 
-// The PNM checks (issue 15: maxval 0, samples above maxval) refuse nothing
+// The PNM checks (maxval 0, samples above maxval) refuse nothing
 // that is valid: comments anywhere, samples equal to the maxval, packed
 // lines, and a PFM's negative (little-endian) scale.
 TEST(Texture, ValidPnmAndPfmTexturesStillLoad) {
@@ -626,7 +626,7 @@ TEST(Accel, NoneSphereAndBvhGiveBitIdenticalImages) {
 // (its origin moves by up to 2^-24 of 1e6, 0.06 here), so its hits can lie
 // outside the mesh's exact bounding sphere: the sphere test is widened as
 // the BVH's boxes are, and the three accelerations agree (they lost 182
-// pixels at 1e6 before; hostile pass).
+// pixels at 1e6 before).
 TEST(Accel, FarFromTheOriginFloatSphereTestKeepsEveryHit) {
   const auto dir = temp_dir();
   write_text(dir / "ball.obj", uv_sphere_obj(8, 16, false));
@@ -653,8 +653,8 @@ TEST(Accel, FarFromTheOriginFloatSphereTestKeepsEveryHit) {
 // first, so skipping back faces changes no camera hit. Secondary rays are
 // not culled: near a smooth mesh's shading terminator a shadow ray can run
 // into the mesh (its shading normal faces the light, its geometric normal
-// away), and culled back faces let it through, a lit seam (hostile pass:
-// 42 pixels up to 143 levels). So the whole image is the same, flat and
+// away), and culled back faces let it through, a lit seam
+// (42 pixels up to 143 levels). So the whole image is the same, flat and
 // smooth.
 TEST(Accel, CullingChangesNothingOnClosedMeshesSeenFromOutside) {
   const auto dir = temp_dir();
@@ -742,7 +742,7 @@ TEST(Cull, SkipsBackFacesOfClosedMeshesOnly) {
   }
 }
 
-// Issue 3's check on document 004's cube: rendered with every triangle
+// Every method beside Moller-Trumbore on document 004's cube: rendered with every triangle
 // method in both precisions, an image may differ from Moller-Trumbore's in
 // double (as 8-bit PNGs) only at pixels whose centre ray passes within half a pixel's
 // footprint of a triangle edge (the 12 cube edges or the 6 face diagonals).

@@ -46,14 +46,27 @@ namespace {
       return ns::any(r, a, b, c, cull);                                                       \
     }                                                                                         \
   }
-RA_VERTEX_METHOD(AnglesM, angles);
 RA_VERTEX_METHOD(CramerM, cramer);
-RA_VERTEX_METHOD(AreasM, areas);
 RA_VERTEX_METHOD(TripleM, triple);
-RA_VERTEX_METHOD(SamesideM, sameside);
 RA_VERTEX_METHOD(WatertightM, watertight);
 RA_VERTEX_METHOD(BaldwinM, baldwin);
 #undef RA_VERTEX_METHOD
+
+// The documents' methods that decide only t (ns::accept); detail::DecidesT
+// (methods/point_barycentrics.h) gives their hit and any.
+#define RA_DECIDES_T(Struct, ns)                                                                  \
+  struct Struct##Doc {                                                                            \
+    template <class T>                                                                            \
+    static std::optional<T> accept(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,           \
+                                   const Vec3<T>& c, bool cull) {                                 \
+      return ns::accept(r, a, b, c, cull);                                                        \
+    }                                                                                             \
+  };                                                                                              \
+  using Struct = detail::DecidesT<Struct##Doc>
+RA_DECIDES_T(AnglesM, angles);
+RA_DECIDES_T(AreasM, areas);
+RA_DECIDES_T(SamesideM, sameside);
+#undef RA_DECIDES_T
 
 struct MollerM {
   template <class T>

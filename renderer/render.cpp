@@ -180,7 +180,7 @@ struct Tracer::Impl {
     shadow_cache_level1.assign(s.lights.size(), -1);
     shadow_cache_other.assign(s.lights.size(), -1);
     // A set placed by several objects (a scene repeating one mesh) is
-    // prepared once (HOSTILE2 F17: 400 placements, 400 BVHs, 3.5 GB).
+    // prepared once (400 placements, 400 BVHs, 3.5 GB).
     std::map<const TriangleSet*, int> prepared;
     for (std::size_t i = 0; i < s.objects.size(); ++i) {
       if (s.objects[i].kind != Object::Kind::mesh) continue;
@@ -246,7 +246,7 @@ struct Tracer::Impl {
   // Bounding_Threshold (3) of them; with --accel bvh so do we: a BVH over
   // the boxes of the spheres and meshes (a lone triangle is a one-triangle
   // mesh), planes tested for every ray. 30,000 lone triangles took 31 s at
-  // 64x64 by a loop over all objects (HOSTILE2 F18). The image is the same
+  // 64x64 by a loop over all objects. The image is the same
   // bits as that loop's (ties on t go to the lower object whatever the
   // order; object_bvh = false renders the loop for the identity tests),
   // provided every hit a kernel reports lies in its object's box:
@@ -265,7 +265,7 @@ struct Tracer::Impl {
   //    object), as a soup about the same.
   static constexpr std::size_t kObjectBvhMin = 3;
   bool objects_bounded = false;  // the object BVH (and soup) in use
-  Bvh object_bvh;                // over bounded[]
+  Bvh object_bvh;                // over bounded[]; never prefetch_neighbours (traversed without those loops)
   std::vector<int> bounded;      // slot order -> object index
   std::vector<int> unbounded;    // planes
   double reach = 0;              // rays with |o_a| <= reach use object_bvh
@@ -426,7 +426,7 @@ struct Tracer::Impl {
     // The BVH's boxes and the bounding sphere are widened by it: a float
     // kernel answers for the ray rounded to float, whose origin far out
     // moves by 2^-24 of its distance (at 1e6, 0.06), so its hits can lie
-    // outside the mesh's exact sphere (hostile pass: 182 pixels lost at 1e6).
+    // outside the mesh's exact sphere (182 pixels lost at 1e6).
     m.scale = std::max(length(hi - lo), std::max(max_component(abs(lo)), max_component(abs(hi))));
     m.pad = 1e-5 * m.scale;
     m.lo = lo - Vec3d{m.pad, m.pad, m.pad};
@@ -775,7 +775,7 @@ struct Tracer::Impl {
           });
         }
       }
-      traverse<true, kFma>(object_bvh, window.o, window.d, window.tmin, window.tmax,
+      traverse<true, kFma, false>(object_bvh, window.o, window.d, window.tmin, window.tmax,
                            [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                              for (std::uint32_t slot = first; slot < first + count; ++slot)
                                visit(std::size_t(bounded[slot]), true);
@@ -916,7 +916,7 @@ struct Tracer::Impl {
         }
         if (hit) return true;
       }
-      traverse<false, kFma>(object_bvh, r.o, r.d, r.tmin, r.tmax,
+      traverse<false, kFma, false>(object_bvh, r.o, r.d, r.tmin, r.tmax,
                             [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
                               for (std::uint32_t slot = first; slot < first + count; ++slot)
                                 if (visit(std::size_t(bounded[slot]), true)) return hit = true;
@@ -962,7 +962,7 @@ struct Tracer::Impl {
   // shadow or reflected ray leaving a smooth-shaded point near the
   // terminator can run into the mesh (its shading normal faces the light,
   // its geometric normal away), where culled back faces let it through
-  // (a lit seam; hostile pass). Secondary rays are never culled.
+  // (a lit seam). Secondary rays are never culled.
   template <class T>
   std::optional<SceneHit> closest(const Ray<double>& rd, int only = -1, bool cull = false) const {
     if (one_mesh_tri4 && only <= 0)

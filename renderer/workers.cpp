@@ -1,4 +1,4 @@
-// Thread start-up that falls back to fewer threads (issue 15: `info --threads
+// Thread start-up that falls back to fewer threads (`info --threads
 // 100000` and `audit --threads 1024` under a memory limit used to abort).
 #include "workers.h"
 

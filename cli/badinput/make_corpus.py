@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-# Writes the bad-input corpus (issue 15) beside this script: one directory per
-# input kind; cli/badinput_test.cpp runs each file through rayaudit.
+# Writes the bad-input corpus beside this script: one directory per
+# input kind; cli/badinput_corpus_test.cpp runs each file through rayaudit.
 # The files are committed; this script only documents how the binary ones
 # were made (rerun it after changing one). Expected messages: expected.tsv.
 import os, struct, zlib
@@ -20,7 +20,7 @@ def put_dir(kind, name):
     d = os.path.join(HERE, kind, name)
     os.makedirs(d, exist_ok=True)
     with open(os.path.join(d, 'README'), 'w') as f:
-        f.write('A directory given where a file is expected (issue 15).\n')
+        f.write('A directory given where a file is expected.\n')
 
 TRI = 'v 0 0 0\nv 1 0 0\nv 0 1 0\n'
 
@@ -169,7 +169,7 @@ put('golden', 'width_string.json', '{"goldens": [{"name": "a", "scene": "scenes/
 put('golden', 'listed_twice.json', '{"goldens": [' + ','.join(
     ['{"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "width": 8, "height": 8, "inputs_hash": "x"}'] * 2)
     + ']}\n')
-# An entry read strictly (HOSTILE2 F5): unknown keys, sizes that are not integers.
+# An entry read strictly: unknown keys, sizes that are not integers.
 GOLDEN_A = '"name": "a", "scene": "scenes/a.json", "image": "golden/a.png", "height": 8, "inputs_hash": "x"'
 put('golden', 'unknown_key.json', '{"goldens": [{' + GOLDEN_A + ', "width": 8,\n "widht": 8}]}\n')
 put('golden', 'width_fraction.json', '{"goldens": [{' + GOLDEN_A + ', "width": 1.5}]}\n')
@@ -195,7 +195,7 @@ put('texture', 'not_an_exr.exr', 'v/1\x01 not really an EXR\n')
 put('texture', 'zero_width.png', png(0, 4, zlib.compress(b'\x00' * 4)))
 put_dir('texture', 'is_a_directory.png')
 
-# ---- second hostile pass (issue 15) ----
+# ---- across kinds: values out of range, NaN, bytes that are not UTF-8, paths that loop ----
 PH = 'ply\nformat ascii 1.0\nelement vertex 3\n'
 put('ply', 'duplicate_property.ply', PH + 'property float x\nproperty float x\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n')
 put('ply', 'list_count_float.ply', PH + 'property float x\nproperty float y\nproperty float z\nelement face 1\nproperty list float int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
@@ -223,7 +223,7 @@ loop = os.path.join(HERE, 'texture', 'symlink_loop.png')
 if not os.path.islink(loop):
     os.symlink('symlink_loop.png', loop)
 
-# Third pass (issue 15): -2^63 as a relative index (its negation overflowed,
+# -2^63 as a relative index (its negation overflowed,
 # and the index read before the first vertex).
 V3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
 put("obj", "face_index_neg_2p63.obj", V3 + "f 1 2 -9223372036854775808\n")
@@ -244,7 +244,7 @@ put('scene', 'radius_denormal.json', '{"objects": [{"sphere": {"radius": 1e-320}
 put('scene', 'adc_bailout_negative.json', '{"adc_bailout": -1, "objects": [{"sphere": {"radius": 1}}]}\n')
 put('scene', 'mesh_is_json.json', '{"objects": [{"mesh": "mesh_is_json.json"}]}\n')
 
-# Fourth pass (issue 15): what the magic or the counts promise; header
+# What the magic or the counts promise; header
 # errors at their header line; CR-only line ends counted as line ends.
 put('off', 'noff_without_normals.off', 'NOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
 put('off', 'coff_without_colours.off', 'COFF\n3 1 0\n0 0 0 1 1 1 1\n1 0 0\n0 1 0 1 1 1 1\n3 0 1 2\n')
@@ -283,7 +283,7 @@ put('mtl', 'map_bump_empty_file.mtl', 'newmtl a\nmap_bump ../texture/zero_bytes.
 put('mtl', 'map_kd_png_without_iend.mtl', 'newmtl a\nKd 1 1 1\nmap_Kd ../texture/png_without_iend.png\n')
 put('mtl', 'bump_ppm_maxval_0.mtl', 'newmtl a\nbump -bm 2 ../texture/ppm_maxval_0.ppm\n')
 put('golden', 'deep_nesting.json', '{"goldens": ' + '[' * 100000 + '\n')
-# Second hostile pass (HOSTILE2 F14-F16): PLY/OFF data the header does not
+# PLY/OFF data the header does not
 # declare, an element twice, a float beyond float, counts beyond three.
 PLY3 = 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1
 put('ply', 'element_twice.ply', 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n' + FACE1 + '0 0 0\n1 0 0\n0 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
@@ -297,7 +297,7 @@ put('off', 'trailing_face.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1
 put('off', 'vertex_extra_values.off', 'OFF\n3 1 0\n0 0 0 9 9\n1 0 0\n0 1 0\n3 0 1 2\n')
 put('off', 'four_counts.off', 'OFF\n3 1 0 7\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n')
 put('off', 'face_word_after_indices.off', 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 xyz\n')
-# Second hostile pass (HOSTILE2 F8-F11): sizes OIIO's GIF reader allocated in
+# Sizes OIIO's GIF reader allocated in
 # open(), PNM/PFM values out of range, non-finite texels, a GIF without image.
 put('texture', 'gif_16384_in_35_bytes.gif', b'GIF89a\x00\x40\x00\x40\x80\x00\x00\x00\x00\x00\xff\xff\xff,\x00\x00\x00\x00\x00\x40\x00\x40\x00\x02\x02\x44\x01\x00;')
 put('texture', 'gif_without_image.gif', b'GIF89a\x04\x00\x04\x00\x00\x00\x00;')
@@ -308,7 +308,7 @@ put('texture', 'p2_negative_sample.pgm', 'P2\n2 2\n15\n-5 0 0 0\n')
 put('texture', 'pbm_bit_2.pbm', 'P1\n2 2\n0 2 0 1\n')
 put('texture', 'pfm_scale_0.pfm', b'PF\n2 2\n0\n' + struct.pack('<f', 1.0) * 12)
 put('texture', 'pfm_nan_texel.pfm', b'PF\n2 2\n-1.0\n' + struct.pack('<f', 0.5) * 3 + struct.pack('<f', float('nan')) * 9)
-# HOSTILE2 F21, F23: the file's own number quoted; a directory named as such.
+# The file's own number quoted; a directory named as such.
 put('tolerance', 'pixel_x_2p63.json', '{"width": 8, "height": 8, "pixels": [{"x": 9223372036854775808, "y": 1, "levels": 1, "cause": "c"}]}\n')
 put_dir('tolerance', 'is_a_directory.json')
 # PNM data shorter than the header promises (OIIO: "unreadable or

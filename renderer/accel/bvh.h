@@ -581,7 +581,12 @@ template <bool kFused, bool kNeighbours, class T, class Leaf, class LeafPrefetch
 // order, without sorting (traverse_any_loop).
 // Always inlined, so that it is compiled for the ISA of its caller; kFma
 // only from callers compiled for AVX2 and FMA (meet8_fma's instructions).
-template <bool kClosest, bool kFma = false, class T, class Leaf, class LeafPrefetch>
+// kNeighbourLoops false: for a BVH whose owner never sets
+// prefetch_neighbours (the tracer's object BVH), only the loops without the
+// neighbours' requests are compiled. Each loop inlines the caller's leaf
+// test, which for the object BVH holds every object's own traversal: the
+// loops it never runs doubled the code, and the compile time, of its callers.
+template <bool kClosest, bool kFma = false, bool kNeighbourLoops = true, class T, class Leaf, class LeafPrefetch>
 [[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
                                             Leaf&& leaf, LeafPrefetch&& leaf_prefetch) {
   using namespace bvh_detail;
@@ -601,14 +606,16 @@ template <bool kClosest, bool kFma = false, class T, class Leaf, class LeafPrefe
       traverse_closest_loop<false, kN>(bvh, r, tmax, leaf, leaf_prefetch);
     }
   };
-  if (bvh.prefetch_neighbours) loops(std::true_type{});
-  else loops(std::false_type{});
+  if constexpr (kNeighbourLoops) {
+    if (bvh.prefetch_neighbours) return loops(std::true_type{});
+  }
+  loops(std::false_type{});
 }
 
-template <bool kClosest, bool kFma = false, class T, class Leaf>
+template <bool kClosest, bool kFma = false, bool kNeighbourLoops = true, class T, class Leaf>
 [[gnu::always_inline]] inline void traverse(const Bvh& bvh, const Vec3<T>& o, const Vec3<T>& d, T tmin, const T& tmax,
                                             Leaf&& leaf) {
-  traverse<kClosest, kFma>(bvh, o, d, tmin, tmax, leaf, [](std::uint32_t) {});
+  traverse<kClosest, kFma, kNeighbourLoops>(bvh, o, d, tmin, tmax, leaf, [](std::uint32_t) {});
 }
 
 }  // namespace ra

@@ -1,5 +1,5 @@
 // The BVH over a scene's objects (render.cpp, POV-Ray's automatic bounding;
-// HOSTILE2 F17, F18): the same image, bit for bit, as the loop over every
+// scenes of thousands of objects): the same image, bit for bit, as the loop over every
 // object, for every method and precision; a repeated mesh is one set.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -97,8 +97,8 @@ TEST(ObjectBvh, SameBitsAsTheLoopOverObjectsForEveryMethodAndPrecision) {
       o.object_bvh = true;
       const Image bvh = render(scene, o);
       EXPECT_EQ(loop.rgb, bvh.rgb) << m.name << " / " << o.sphere_method << (dbl ? " double" : " float");
-      // Asking for the nodes and leaves beside those met (every BVH: the
-      // objects', the soup's and each mesh's) changes no bit.
+      // Asking for the nodes and leaves beside those met (the soup's BVH
+      // and each mesh's; the objects' BVH never asks) changes no bit.
       o.neighbour_prefetch = RenderOptions::NeighbourPrefetch::always;
       EXPECT_EQ(loop.rgb, render(scene, o).rgb) << m.name << " with neighbour prefetch";
       for (float v : loop.rgb) nonblack += v > 0.05f;

@@ -92,7 +92,7 @@ struct MtlParser {
     return x;
   }
   // As a scene's numbers (scene.cpp): a Kd of 1e308 overflowed the shading
-  // to +inf, reported as a reflection problem of the render (hostile pass).
+  // to +inf, reported as a reflection problem of the render.
   void bounded(const double* x, int n, long line, const char* what) {
     for (int i = 0; i < n; ++i)
       if (!(std::abs(x[i]) <= 1e30)) {

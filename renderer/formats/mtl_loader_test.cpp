@@ -90,7 +90,7 @@ TEST(Mtl, WarningsAndErrors) {
   EXPECT_EQ(error_of("newmtl a\nmap_Kd -s 1 1 1\n"), "m.mtl:2: texture statement without a file name");
 }
 
-// Issue 15 (HOSTILE2 F24): a flood of one kind of warning is ten lines and
+// A flood of one kind of warning is ten lines and
 // a count, and distinct unknown statements are found in linear time.
 TEST(Mtl, WarningsOfOneKindAreTenLinesAndACount) {
   std::string text;

@@ -635,7 +635,7 @@ struct ChunkParser {
       w.fail(line, "v needs x y z, x y z w or x y z r g b (" + std::to_string(n) + " values given)");
     // As a scene's numbers (scene.cpp): beyond 1e30 a coordinate's square
     // overflows the kernels' products, and a 1e80 triangle rendered as
-    // ambient only, from 1e120 black, with exit 0 (hostile pass).
+    // ambient only, from 1e120 black, with exit 0.
     for (int k = 0; k < 3; ++k)
       if (!(std::abs(x[k]) <= 1e30))
       {
@@ -691,7 +691,7 @@ struct ChunkParser {
       out = int(i - 1);
     } else {
       // i < -count, not -i > count: -i overflows for i = -2^63 (which
-      // then passed and read before the first vertex; issue 15).
+      // then passed and read before the first vertex).
       if (i < -static_cast<long long>(count))
         w.fail(line, std::string("relative ") + kind + " index " + std::to_string(i) +
                          " reaches before the first one (" + std::to_string(count) + " defined before this " + stmt + ")");
@@ -870,7 +870,7 @@ struct ChunkParser {
     // Never more than the rest of the file can hold: every further triangle
     // needs a corner of at least 2 bytes ("1 "). Inside one long face the
     // bytes read so far are few, and the extrapolation alone asked for
-    // terabytes (a 2 MB face of 1M corners: std::bad_alloc, issue 15).
+    // terabytes (a 2 MB face of 1M corners: std::bad_alloc).
     const size_t most = v.size() + size_t(c.end - here) / 2 + 64;
     const double estimate = double(v.size()) * (total / done) * 1.05 + 64;
     const size_t guess = estimate < double(most) ? size_t(estimate) : most;
@@ -915,7 +915,7 @@ struct ChunkParser {
 
   void unknown(const char* k, const char* kend, long line) {
     // A map, not a scan of those seen: 100k distinct unknown keywords
-    // took over 20 s (issue 15).
+    // took over 20 s.
     std::string kw(k, size_t(kend - k));
     const auto [it, fresh] = c.unknown_at.try_emplace(kw, c.unknown.size());
     if (fresh) c.unknown.push_back({std::move(kw), line, 1});
@@ -1304,7 +1304,7 @@ class FileBytes {
  public:
   FileBytes(const std::filesystem::path& file, std::uint64_t max_bytes) {
     // Noted as an input on the mapped path too: crack-maps --mesh naming one
-    // of its own maps was overwritten (HOSTILE2 F22).
+    // of its own maps was overwritten.
     check_input_file(file);
     std::error_code ec;
     const auto size = std::filesystem::file_size(file, ec);

@@ -736,5 +736,17 @@ TEST(ObjParallel, SameErrorAsSerial) {
   EXPECT_EQ(parallel, serial);
 }
 
+// Distinct unsupported keywords: the first ten warned one line each, the
+// rest in one line (100k of them printed 100k lines, in quadratic time).
+TEST(ObjWarnings, ManyUnsupportedKeywordsAreTenLinesAndACount) {
+  std::string text = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  for (int i = 0; i < 25; ++i) text += "zz" + std::to_string(i) + " 1\nzz" + std::to_string(i) + " 2\n";
+  text += "f 1 2 3\n";
+  const Mesh m = parse_obj(text, "kw.obj");
+  ASSERT_EQ(m.warnings.size(), 11u);
+  EXPECT_EQ(m.warnings[0], "kw.obj:4: unsupported statement 'zz0' ignored (2 lines)");
+  EXPECT_EQ(m.warnings[10], "kw.obj:24: 15 more unsupported keywords ignored (30 lines)");
+}
+
 }  // namespace
 }  // namespace ra

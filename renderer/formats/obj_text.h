@@ -19,7 +19,7 @@
 namespace ra::objtext {
 
 // Warnings of one kind: the first ten one line each, the rest counted in
-// one line by finish() (issue 15: 50,000 missing mtllib files, undefined
+// one line by finish() (50,000 missing mtllib files, undefined
 // materials or statements before newmtl printed 50,000 lines).
 struct CappedWarnings {
   static constexpr long kShown = 10;

@@ -23,7 +23,7 @@ struct Tokens {
 
   [[noreturn]] void fail(const std::string& msg) const { throw InputError(located(name, line, msg)); }
   // A line ends at \n, \r\n or a lone \r (classic Mac OS): a CR-only file
-  // was one line, its errors all at line 1 (issue 15's fourth pass).
+  // was one line, its errors all at line 1.
   bool eol(const char* q) const { return *q == '\n' || (*q == '\r' && (q + 1 == e || q[1] != '\n')); }
   // Skips spaces (and line ends when `lines`), and '#' comments.
   void skip(bool lines) {
@@ -242,7 +242,7 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       if (!ply_type(ty, pr.type)) t.fail("unknown property type '" + std::string(ty) + "'");
       pr.name = std::string(t.word());
       // Was "vertex element without x, y, z" for x, x, z. A set: comparing with
-      // every earlier property took 8.5 s for 80,000 of them (issue 15).
+      // every earlier property took 8.5 s for 80,000 of them.
       if (!prop_names.insert(pr.name).second) t.fail("property '" + pr.name + "' given twice in one element");
       if (pr.list && (pr.count_type == PlyType::F32 || pr.count_type == PlyType::F64))
         t.fail("list count type must be an integer type");
@@ -336,7 +336,7 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
           const double v = value(pr.type);
           if ((int(i) == ix || int(i) == iy || int(i) == iz) && !std::isfinite(v))
             fail("vertex " + std::to_string(r) + " has coordinate " + number_text(v) + " (not finite)");
-          // As the OBJ reader does: the converted file must load (hostile pass).
+          // As the OBJ reader does: the converted file must load.
           if ((int(i) == ix || int(i) == iy || int(i) == iz) && !(std::abs(v) <= 1e30))
             fail("vertex " + std::to_string(r) + " has coordinate " + number_text(v) + " (magnitude above 1e30)");
           if (int(i) == ix) pos.x = v;

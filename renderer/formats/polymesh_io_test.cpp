@@ -102,7 +102,7 @@ TEST(Off, ReadsWithCommentsAndColours) {
 }
 
 // The values a magic promises are accepted in each form (a colour of 3 or
-// 4), and a CR-only file reads as lines (issue 15's fourth pass).
+// 4), and a CR-only file reads as lines.
 TEST(Off, ExtrasTheMagicPromisesAndCrOnlyLineEnds) {
   const std::string v = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n";
   auto with = [&](const std::string& extra) {

@@ -70,7 +70,7 @@ bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
   // the whole polygon, a star's inner corners, 1% of its radius from the
   // centre, shared one or two cells, so every spike's ear scanned all of
   // them: 2,000 corners spent the work limit and came out as a fan 118
-  // times the star's area (hostile pass).
+  // times the star's area.
   s.reflex.clear();
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
   for (int i = 0; i < n; ++i) {

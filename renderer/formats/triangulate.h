@@ -17,7 +17,7 @@
 // of its radius still tiles exactly; a face of a million corners then takes
 // 1.4 s instead of 0.75) has its
 // remaining corners cut in order, like a degenerate one. So any file
-// triangulates in time linear in its size (issue 15). Those triangles may
+// triangulates in time linear in its size. Those triangles may
 // overlap or leave gaps: triangulate_polygon returns true then, and the OBJ
 // reader warns "FILE:LINE: polygon of N corners ..." (the file still loads:
 // the mesh is what the file says up to that polygon's tiling).
@@ -33,7 +33,7 @@ inline constexpr long kEarClipWorkPerCorner = 500;
 
 // Readers refuse a polygon of more corners (FILE:LINE): its triangulation
 // holds about 130 bytes a corner (a 20 MB face of 9M corners needed 1.2 GB
-// and 200 steps a corner; issue 15). No real mesh comes near it.
+// and 200 steps a corner). No real mesh comes near it.
 inline constexpr int kMaxPolygonCorners = 1000000;  // as PLY and OFF face sizes
 
 struct EarClipScratch {

@@ -46,7 +46,7 @@ std::string printable(const std::string& s) {
 namespace {
 // A message quoting an input stays readable whatever the input held: text
 // beyond `max` bytes is cut from the middle, saying how much (a 100 MB mesh
-// path in a scene gave a 100 MB stderr line; issue 15's second pass).
+// path in a scene gave a 100 MB stderr line).
 std::string shortened(const std::string& s, std::size_t max) {
   if (s.size() <= max) return s;
   const std::size_t head = max * 3 / 4, tail = max / 4;
@@ -110,7 +110,7 @@ void check_output_path(const std::filesystem::path& path) {
   }
   // An existing output that is not a regular file is refused: the renamed
   // temporary would replace it (run as root, -o /dev/full turned the device
-  // into a file; issue 15's second pass).
+  // into a file).
   const fs::file_status st = fs::status(path, ec);
   if (st.type() == fs::file_type::not_found) return;
   if (ec) throw InputError(located(path.string(), 0, "cannot write: " + ec.message()));

@@ -1,5 +1,5 @@
-// Inputs and outputs of one run, by file identity (issue 15's second pass:
-// `render s.json -o tex.png` replaced the scene's texture; `--json X --csv X` lost one).
+// Inputs and outputs of one run, by file identity
+// (`render s.json -o tex.png` replaced the scene's texture; `--json X --csv X` lost one).
 #include "file_identity.h"
 
 #include <sys/stat.h>

@@ -1,5 +1,5 @@
 // Which files this run reads and which it will write, compared by identity
-// (st_dev, st_ino): an output that is also an input, or two outputs on one path, is refused (issue 15).
+// (st_dev, st_ino): an output that is also an input, or two outputs on one path, is refused.
 #pragma once
 #include <filesystem>
 

@@ -1,5 +1,5 @@
 // Test fixture: a tiny tmpfs, nearly filled, so that writes fail with ENOSPC
-// as on a full disk (issue 15). Mounting needs root (CI runs as root); tests
+// as on a full disk. Mounting needs root (CI runs as root); tests
 // skip with the reason otherwise.
 #pragma once
 #include <sys/mount.h>

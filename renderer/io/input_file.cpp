@@ -1,4 +1,4 @@
-// Input path checks shared by every reader (issue 15: a directory given as a
+// Input path checks shared by every reader (a directory given as a
 // scene read "no such file", a FIFO as texture or CSV blocked forever).
 #include "input_file.h"
 

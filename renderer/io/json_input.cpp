@@ -1,4 +1,4 @@
-// A SAX front end to nlohmann's DOM parser (issue 15: raw library messages,
+// A SAX front end to nlohmann's DOM parser (raw library messages,
 // the line of an overflowing number, duplicate keys accepted silently).
 #include "json_input.h"
 
@@ -18,7 +18,7 @@ namespace {
 using json = nlohmann::json;
 
 // Lines end at \n, \r\n or a lone \r (a CR-only file put every error at
-// line 1: issue 15's fourth pass).
+// line 1).
 long line_at(const std::string& text, std::size_t byte) {
   long line = 1;
   for (std::size_t i = 0; i < byte && i < text.size(); ++i)

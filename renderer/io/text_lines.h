@@ -1,5 +1,5 @@
 // Text read line by line with every kind of line end counted: \n, \r\n and
-// a lone \r (classic Mac OS), so messages name the right line (issue 15).
+// a lone \r (classic Mac OS), so messages name the right line.
 #pragma once
 #include <cstdio>
 #include <istream>

@@ -18,6 +18,8 @@ inline constexpr double PLUS_ZERO = 0.00001;
 inline constexpr double MINUS_ZERO = -0.0001;
 
 // The hit parameter if the document accepts the hit, nothing otherwise.
+// Barycentrics are not part of the method: detail::DecidesT
+// (point_barycentrics.h) computes them from the hit point after this decision.
 // The normal is normalised (the listing's MyPlane.ABC is the plane's normal),
 // so (fa x fb).n is twice the signed area of PAB and MINUS_ZERO is an area
 // tolerance: it admits points up to 1e-4 / |AB| outside edge AB.
@@ -41,21 +43,6 @@ std::optional<T> accept(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, con
   if (dot(cross(fb, fc), n) < T(MINUS_ZERO)) return std::nullopt;
   if (dot(cross(fc, fa), n) < T(MINUS_ZERO)) return std::nullopt;
   return t;
-}
-
-// Barycentrics are not part of the method: computed from the hit point after
-// the document's own inside decision.
-template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                  const Vec3<T>& c, bool cull) {
-  const auto t = accept(r, a, b, c, cull);
-  if (!t) return std::nullopt;
-  return detail::hit_from_point(*t, r.at(*t), a, b, c);
-}
-
-template <class T>
-bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
-  return accept(r, a, b, c, cull).has_value();
 }
 
 }  // namespace ra::angles

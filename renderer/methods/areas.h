@@ -34,6 +34,8 @@ T area(const Vec3<T>& v1, const Vec3<T>& v2, const Vec3<T>& v3) {
 }
 
 // The hit parameter if the document accepts the hit, nothing otherwise.
+// Barycentrics are not part of the method: detail::DecidesT
+// (point_barycentrics.h) computes them from the hit point after this decision.
 template <class T>
 std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C,
                         bool cull) {
@@ -55,21 +57,6 @@ std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, con
   const T abp = area(A, B, ip);
   if (pbc + apc + abp > abc + T(epsilon3)) return std::nullopt;
   return t;
-}
-
-// Barycentrics are not part of the method (its areas are unsigned): computed
-// from the hit point after the document's own inside decision.
-template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                  const Vec3<T>& c, bool cull) {
-  const auto t = accept(r, a, b, c, cull);
-  if (!t) return std::nullopt;
-  return detail::hit_from_point(*t, r.at(*t), a, b, c);
-}
-
-template <class T>
-bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
-  return accept(r, a, b, c, cull).has_value();
 }
 
 }  // namespace ra::areas

@@ -1,6 +1,8 @@
 // Shared by the document methods that decide inside/outside without computing
 // barycentrics (angles, areas, sameside): (b1, b2) of a point, after the fact.
 #pragma once
+#include <optional>
+
 #include "../hit.h"
 #include "../ray.h"
 
@@ -32,5 +34,24 @@ template <class T>
 bool culled(const Ray<T>& r, const Vec3<T>& n) {
   return !(dot(r.d, n) < T(0));
 }
+
+// hit() and any() of a document method that decides only t (angles, areas,
+// sameside: D::accept, the document's own plane step and inside test). Their
+// barycentrics are not part of the method: hit() computes them from the hit
+// point after the document's inside decision; any() is that decision.
+template <class D>
+struct DecidesT {
+  template <class T>
+  static std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
+                                           const Vec3<T>& c, bool cull) {
+    const std::optional<T> t = D::template accept<T>(r, a, b, c, cull);
+    if (!t) return std::nullopt;
+    return hit_from_point(*t, r.at(*t), a, b, c);
+  }
+  template <class T>
+  static bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
+    return D::template accept<T>(r, a, b, c, cull).has_value();
+  }
+};
 
 }  // namespace ra::detail

@@ -24,6 +24,8 @@ bool same_side(const Vec3<T>& p1, const Vec3<T>& p2, const Vec3<T>& a, const Vec
 }
 
 // The hit parameter if the document accepts the hit, nothing otherwise.
+// Barycentrics are not part of the method: detail::DecidesT
+// (point_barycentrics.h) computes them from the hit point after this decision.
 template <class T>
 std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C,
                         bool cull) {
@@ -42,21 +44,6 @@ std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, con
   if (!(same_side(p, A, B, C) && same_side(p, B, A, C) && same_side(p, C, A, B)))
     return std::nullopt;
   return u;
-}
-
-// Barycentrics are not part of the method: computed from the hit point after
-// the document's own inside decision.
-template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                  const Vec3<T>& c, bool cull) {
-  const auto t = accept(r, a, b, c, cull);
-  if (!t) return std::nullopt;
-  return detail::hit_from_point(*t, r.at(*t), a, b, c);
-}
-
-template <class T>
-bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
-  return accept(r, a, b, c, cull).has_value();
 }
 
 }  // namespace ra::sameside

@@ -105,7 +105,7 @@ bool read(void* image, int channels, int type, void* dst, std::string* err) try 
   }
   // Some readers return true for a truncated file (a JPEG cut short, a PNG
   // without IEND) and only record the error: such a texture was used with
-  // its missing part grey (issue 15's third pass).
+  // its missing part grey.
   if (in->has_error()) {
     *err = first_line(in->geterror());
     return false;
@@ -163,7 +163,7 @@ extern "C" __attribute__((visibility("default"))) const Api* rayaudit_image_modu
   // OpenImageIO and OpenEXR start thread pools of their own (one thread a
   // core, each with a stack and a malloc arena of address space), which
   // abort or hang when the system refuses a thread (under an address-space
-  // limit of 410-450 MB: HOSTILE2 F28). Our images are small (textures,
+  // limit of 410-450 MB). Our images are small (textures,
   // goldens, one render): each call works on the calling thread.
   static const bool single = [] {
     OIIO::attribute("threads", 1);

@@ -145,7 +145,7 @@ TextureFilter parse_filter(ObjectReader& r, const std::string& key) {
 }
 
 // A path no file system takes (PATH_MAX, 4096 bytes) is said as such, not
-// looked up and quoted whole (a 100 MB "mesh" string: issue 15's second pass).
+// looked up and quoted whole (a 100 MB "mesh" string).
 std::string path_string(ObjectReader& r, const std::string& key) {
   std::string p = r.string(key, "");
   if (p.size() >= 4096)
@@ -206,7 +206,7 @@ Material parse_material(const json& j, const std::string& path, const std::files
 
 // Placed meshes by their object's JSON: a scene placing one mesh the same
 // way many times loads and prepares it once (400 placements of a 69,666-
-// triangle mesh took 21.6 s and 3.5 GB: issue 15's second pass). Objects
+// triangle mesh took 21.6 s and 3.5 GB). Objects
 // share the TriangleSet; the tracer prepares each set once.
 using PlacedMeshes = std::map<std::string, std::shared_ptr<TriangleSet>>;
 
@@ -307,7 +307,7 @@ Scene parse_scene_json(const std::string& text, const std::filesystem::path& fil
     if (!(s.camera.vfov > 0 && s.camera.vfov < 180)) c.fail(c.at("vfov"), "must be between 0 and 180 degrees");
     // POV-Ray's rule (parse.cpp: |look_at - location|^2 < EPSILON = 1e-10 is
     // "Camera location and look_at point must be different"): a camera 1e-6
-    // from its look_at rendered here and failed there (hostile pass).
+    // from its look_at rendered here and failed there.
     if (!(dot(s.camera.look_at - s.camera.position, s.camera.look_at - s.camera.position) >= 1e-10))
       c.fail(c.at("look_at"), "must be at least 1e-5 from the position (POV-Ray refuses a nearer one)");
     if (length(cross(s.camera.look_at - s.camera.position, s.camera.up)) == 0)

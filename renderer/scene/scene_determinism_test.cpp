@@ -1,4 +1,4 @@
-// Determinism (issue 15): every shipped scene (scenes/*.json) renders to the
+// Determinism: every shipped scene (scenes/*.json) renders to the
 // same image with 1, 2 and 7 threads, and so does the mesh ladder
 // (scenes/corpus/*.json) but for the 1M-triangle dragon. Scenes are rendered at 96 x 72 so the test stays
 // fast; one whose mesh is in the corpus cache skips without it.

@@ -72,7 +72,7 @@ void check_mesh_format(const std::filesystem::path& file) {
 std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {
   check_mesh_format(place.file);
   // A scene (even the scene itself) named as a mesh read as an OBJ of
-  // unknown statements: warnings, and an empty mesh rendered (issue 15).
+  // unknown statements: warnings, and an empty mesh rendered.
   if (place.file.extension() == ".json" || place.file.extension() == ".JSON")
     throw InputError(located(place.file.string(), 0, "a JSON file, not a mesh: a scene's \"mesh\" names an OBJ file"));
   ObjOptions opt;

@@ -1,4 +1,4 @@
-// The audit engine (issue 6): every subject x precision x family x sweep value,
+// The audit engine: every subject x precision x family x sweep value,
 // graded against the exact oracle; statistics merge commutatively, so results never depend on threads.
 #include "audit.h"
 
@@ -158,7 +158,7 @@ nlohmann::json Stats::histograms_json() const {
 }
 
 namespace {
-// What a shard's stats can hold (HOSTILE2 F27: unknown keys and counts no
+// What a shard's stats can hold (unknown keys and counts no
 // run can give, false_hits 1000 of 10 tests, were merged as given). The
 // invariants are those book() keeps: each test counted under exactly one
 // verdict, and every part no larger than its whole.
@@ -312,7 +312,7 @@ int crossings(const oracle::Answer* a, int n) {
 // (a ray through a shared edge or vertex, which the closed triangles of the
 // oracle's rule each contain) count once; any other hit counts itself. An
 // exact intersector that answered both triangles of an edge it crossed
-// exactly had 2,103 double hits and ranked below moller (hostile pass).
+// exactly had 2,103 double hits and ranked below moller.
 struct GroupHits {
   int hits = 0, crossings_hit = 0;
   std::vector<double> boundary_t;

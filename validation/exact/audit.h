@@ -204,7 +204,7 @@ struct ProbeCase {
   std::vector<oracle::Answer> answers;
 };
 // probe_cases() one at a time, chunk by chunk (the same cases in the same
-// order), so an export's memory does not grow with --rays (HOSTILE2 F29).
+// order), so an export's memory does not grow with --rays.
 void for_each_probe_case(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays,
                          const std::function<void(const ProbeCase&)>& visit);
 std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,

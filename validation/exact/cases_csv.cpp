@@ -38,7 +38,7 @@ std::string number(double x, Numbers n) {
 
 // A column named twice would make one of the two silently ignored.
 void check_unique_columns(const std::string& path, long lineno, const std::vector<std::string>& header) {
-  // A set, not all pairs: a header of 200k columns took over 20 s (issue 15).
+  // A set, not all pairs: a header of 200k columns took over 20 s.
   std::unordered_set<std::string_view> seen;
   seen.reserve(header.size());
   for (const auto& h : header)
@@ -135,7 +135,7 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
       const bool number = parse_double(f[std::size_t(col[k])], v[k]);
       if (!number || !std::isfinite(v[k])) {
         // A NaN or infinite coordinate was accepted and judged; a 2 MB
-        // number was quoted whole (issue 15's second pass).
+        // number was quoted whole.
         const std::string& t = f[std::size_t(col[k])];
         const std::string shown = t.size() > 40 ? t.substr(0, 40) + "... (" + std::to_string(t.size()) + " bytes)" : t;
         throw InputError(located(path, lineno, std::string("column '") + kColumns[k] + "': '" + shown +

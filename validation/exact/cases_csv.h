@@ -32,7 +32,7 @@ std::vector<UserCase> read_cases_csv(const std::string& path);
 
 // The same parser, streaming: calls visit(case, line) for each data row in
 // file order, holding one row at a time, so memory does not grow with the
-// file (issue 15). Rows before a malformed one have been visited when it
+// file. Rows before a malformed one have been visited when it
 // throws: callers that must write nothing on bad input read twice (a first
 // pass with a no-op visitor).
 void for_each_case(const std::string& path, const std::function<void(const UserCase&, long line)>& visit);
@@ -58,7 +58,7 @@ std::string cases_csv_row(const ExportRow& r, Numbers n = Numbers::hex);
 std::vector<ExportRow> export_rows(const std::vector<std::string>& families, Precision p,
                                    std::uint64_t seed, long long rays);
 // The same rows one at a time, in the same order, holding one probe's cases
-// at a time (HOSTILE2 F29: 2M rows held 1.7 GB). Returns the number of rows.
+// at a time (2M rows held 1.7 GB). Returns the number of rows.
 long long for_each_export_row(const std::vector<std::string>& families, Precision p, std::uint64_t seed,
                               long long rays, const std::function<void(const ExportRow&)>& visit);
 

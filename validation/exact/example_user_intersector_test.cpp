@@ -81,7 +81,7 @@ auto exact(Mangle mangle) {
       });
 }
 
-// What the checks must refuse (hostile pass): hits whose t a renderer would
+// What the checks must refuse: hits whose t a renderer would
 // drop are leaks all the same; a family name that is not a family judged
 // nothing, and passed; and the exact answer is watertight, with no double
 // hit where it meets a shared edge or vertex exactly.

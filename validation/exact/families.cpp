@@ -1,4 +1,4 @@
-// Case families (issue 6): random, edge, vertex, grazing, offset, distance, scale,
+// Case families: random, edge, vertex, grazing, offset, distance, scale,
 // sliver, near-miss, degenerate, closed-mesh (Embree's WatertightTest placement), secondary; spheres huge, tiny-far, near-origin.
 #include "families.h"
 

@@ -1,5 +1,5 @@
 // Case families for the audit: seeded, reproducible generators of rays and
-// triangles (or spheres), each with a sweep parameter (issue 6; REFERENCES.md).
+// triangles (or spheres), each with a sweep parameter (REFERENCES.md).
 #pragma once
 #include <cstdint>
 #include <string>

@@ -1,4 +1,4 @@
-// Grading intersectors written in any language (issue 16, `rayaudit audit --grade`):
+// Grading intersectors written in any language (`rayaudit audit --grade`):
 // answers computed elsewhere for exported cases, booked exactly as a registered method.
 //
 // ANSWERS.csv: a header naming at least id,hit,t (u,v optional, other

@@ -1,4 +1,4 @@
-// Crack maps (issue 14): renders through the tracer (renderer/render.h) with
+// Crack maps: renders through the tracer (renderer/render.h) with
 // each registered triangle method in float and judges every pixel with the oracle.
 #include "crack_maps.h"
 

@@ -1,4 +1,4 @@
-// Crack maps (issue 14): a closed mesh rendered far from the origin with each
+// Crack maps: a closed mesh rendered far from the origin with each
 // triangle method in float, every pixel whose ray passes through the surface
 // (the oracle or the watertight method finds a crossing, the method none) red.
 #pragma once

@@ -114,8 +114,8 @@ std::string shown(const json& v) {
   return v.type_name();
 }
 
-// One manifest entry, read strictly as scene files are (issue 15's second
-// pass: "spp": 0 put at the wrong level, a misspelt "widht" and "width":
+// One manifest entry, read strictly as scene files are
+// ("spp": 0 put at the wrong level, a misspelt "widht" and "width":
 // 1.5 read as 1 all passed): an unknown key, a value of the wrong type or
 // out of range is an error at its JSON path, quoting the file's value.
 // `fail(path, what)` throws.
@@ -194,7 +194,7 @@ bool inside_root(const std::string& p) {
 // What the manifest's values must be before anything is rendered or
 // written (a width of -8 was "cannot create std::vector larger than
 // max_size()", 100000 a bare bad_alloc; a name of "../x" put the diff image
-// outside --diff-dir: issue 15's second pass).
+// outside --diff-dir).
 std::string entry_problem(const GoldenEntry& e) {
   if (!inside_root(e.name)) return "name \"" + e.name + "\" must be a relative path without \"..\"";
   if (!inside_root(e.scene)) return "scene \"" + e.scene + "\" must be a relative path under the root without \"..\"";
@@ -328,7 +328,7 @@ GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
   try {
     if (!j.is_object() || !j.contains("goldens") || !j.at("goldens").is_array())
       throw InputError(located(m.string(), lines.at("/goldens"), "expected an object with a \"goldens\" array"));
-    // What a reader would otherwise take on trust (hostile pass): a key
+    // What a reader would otherwise take on trust: a key
     // of no meaning, an entry whose scene is another's, two entries
     // sharing one image (each then checked against the other's render).
     for (auto it = j.begin(); it != j.end(); ++it)
@@ -467,7 +467,7 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
   }
   // The golden first: its size, bounded by its file, is checked against the
   // manifest's before a render of the manifest's size (a width of 16384 with
-  // an 8x8 golden rendered 3.3 GB first; issue 15).
+  // an 8x8 golden rendered 3.3 GB first).
   const Image golden = read_image(root_ / g.image);
   if (golden.width != g.width || golden.height != g.height) {
     r.hint = bless_command(name);

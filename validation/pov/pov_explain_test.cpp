@@ -1,4 +1,4 @@
-// --explain against the real POV-Ray 3.7 on the cases of issue 18: the
+// --explain against the real POV-Ray 3.7 on the cases it was made for: the
 // Cornell box's 255-level pixel on the light quad's edge (POV's own mesh2
 // inside test), and random scene 3-179's pixel decided by POV's float32
 // Perp vector of smooth mesh2 triangles.
@@ -118,7 +118,7 @@ TEST(PovExplain, RandomScene3_179PixelIsPovsFloat32Perp) {
   expect_pixel_differs_and_is_explained_by(scene, 87, 95, "mesh2 hit point");
 }
 
-// The spider at 160 x 120 (issue 18): pixel (87, 53) is 1/255 off, with our
+// The spider at 160 x 120: pixel (87, 53) is 1/255 off, with our
 // value 1e-4 levels from a rounding boundary; POV's Mesh::UVCoord on its
 // double UVs (UV_VECT; only vertices and normals are float32) gives POV's
 // value there, rounding the UVs to float32 does not.

@@ -182,7 +182,7 @@ std::optional<std::string> material_inexpressible(const Material& m) {
 // POV-Ray's image_map and bump_map take integer images: the export copies a
 // texture as a 16-bit PNG, which rounds a float image's values and clamps
 // them to [0, 1] (an EXR of values up to 3 rendered 8,114 pixels unlike
-// POV-Ray, reported as unexplained; hostile pass). Read once per file.
+// POV-Ray, reported as unexplained). Read once per file.
 std::optional<std::string> float_images(const Material& m, std::map<std::filesystem::path, bool>& seen) {
   for (const std::filesystem::path* f : {m.texture ? &m.texture->file : nullptr,
                                          m.bump && m.bump->variant == BumpVariant::pov ? &m.bump->file : nullptr}) {
@@ -275,10 +275,10 @@ PovExport export_pov(const Scene& scene, const std::string& image_prefix) {
 
 void copy_pov_image(const std::filesystem::path& source, const std::filesystem::path& dest) {
   // Encoded in memory, then written with every write and close checked:
-  // OIIO's PNG writer does not report a full disk (issue 15).
+  // OIIO's PNG writer does not report a full disk.
   // Read first as a texture is: its header size bounded by the file, a
   // truncated file an error of one line (libpng's own lines kept off
-  // stderr), before the module's copy trusts it (issue 15's third pass).
+  // stderr), before the module's copy trusts it.
   read_stored_pixels(source, "texture");  // its own 8 or 16 bits: not 4 bytes a channel
   std::vector<unsigned char> png;
   std::string err;

@@ -41,7 +41,7 @@ struct WorkDir {
   }
 };
 
-// Ctrl-C, a kill or a hang-up while POV-Ray runs (HOSTILE2 F30: POV-Ray
+// Ctrl-C, a kill or a hang-up while POV-Ray runs (POV-Ray
 // went on rendering as an orphan and its working directory, 64-160 MB, was
 // left in /tmp). While a Interruptible lives, the signal is noted and the
 // child killed at once (only async-signal-safe calls in the handler); when
@@ -96,7 +96,7 @@ ProcessRun run_process(const fs::path& dir, const std::vector<std::string>& argv
   if (pid < 0) throw std::runtime_error("fork failed");
   if (pid == 0) {
     // The child dies with us, whatever ends us (even SIGKILL): never an
-    // orphan POV-Ray rendering for hours (HOSTILE2 F30).
+    // orphan POV-Ray rendering for hours.
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(126);
     const int o = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);

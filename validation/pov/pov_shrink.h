@@ -1,4 +1,4 @@
-// Differential testing against POV-Ray 3.7 (issue 18): compare a scene with
+// Differential testing against POV-Ray 3.7: compare a scene with
 // POV-Ray and explain every differing pixel (pov_explain.h); shrink a scene
 // with an unexplained pixel to a minimal one that still has it, by dropping
 // objects, lights and features one at a time (greedy delta debugging) while

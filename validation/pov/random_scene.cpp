@@ -1,4 +1,4 @@
-// Random scenes for `rayaudit compare --random` (issue 18); see
+// Random scenes for `rayaudit compare --random`; see
 // random_scene.h. Each draw is explicit so a scene is a pure function of
 // (seed, index) and of which corpus files exist.
 #include "random_scene.h"

@@ -1,4 +1,4 @@
-// Random scenes for differential testing against POV-Ray 3.7 (issue 18):
+// Random scenes for differential testing against POV-Ray 3.7:
 // spheres, planes, lone triangles and corpus meshes at random placements,
 // random finishes and corpus textures, 1 to 3 coloured lights, random
 // cameras, max_depth and adc_bailout, written in our JSON scene format.

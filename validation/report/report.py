@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-# The report page (issue 14): charts drawn by matplotlib as inline SVG, thumbnails
+# The report page: charts drawn by matplotlib as inline SVG, thumbnails
 # as data: URIs, one self-contained index.html and the report.json behind it.
 #
 # Run by `rayaudit report` (cli/cmd_report.cpp) with /usr/bin/python3, which has
@@ -50,7 +50,7 @@ MAX_IMAGE_PIXELS = 4096 * 4096
 Image.MAX_IMAGE_PIXELS = None
 
 # The input being read, named by the one-line error if something in it
-# cannot be used (HOSTILE2 F25, F40, F42: tracebacks).
+# cannot be used (tracebacks).
 current_input = ["(report context)"]
 
 
@@ -60,7 +60,7 @@ class BadInput(Exception):
 
 def load_json(path):
     current_input[0] = path
-    # utf-8-sig: a byte-order mark is skipped, as the C++ checks do (F42).
+    # utf-8-sig: a byte-order mark is skipped, as the C++ checks do.
     with open(path, encoding="utf-8-sig") as f:
         return json.load(f)
 ZERO_FLOOR = 1e-5  # where "0 %" is drawn on a log axis
