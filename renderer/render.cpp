@@ -1043,6 +1043,8 @@ struct Tracer::Impl {
         const Vec3d gn = unit_normal(a, b, c);
         s.ng = gn;
         s.n = gn;
+        if (opt.pov_flat_normal && set.shading == Shading::flat)
+          if (const Vec3d pn = pov_mesh_flat_normal(a, b, c); dot(pn, pn) > 0) s.n = pn;
         if (set.shading == Shading::smooth) {
           Vec3d n;
           if (tri.n[0] >= 0 && tri.n[1] >= 0 && tri.n[2] >= 0) {
@@ -1291,13 +1293,14 @@ struct Tracer::Impl {
   std::vector<char> object_opaque;  // POV's OPAQUE_FLAG: no material lets light through
 
   void init_glass() {
+    glass_mode = opt.pov_lighting;
     object_ior.assign(scene.objects.size(), 1.0);
     object_opaque.assign(scene.objects.size(), 1);
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
       auto visit = [&](const Material& m) {
         const bool clear = m.filter > 0 || m.transmit > 0;
         if (clear) object_opaque[i] = 0;
-        if (clear || m.fresnel) glass_mode = true;
+        if (clear || m.fresnel || opt.pov_lighting) glass_mode = true;
         if (m.ior != 1 && object_ior[i] == 1) object_ior[i] = m.ior;
       };
       const Object& o = scene.objects[i];
