@@ -1205,8 +1205,8 @@ struct Tracer::Impl {
 
   Color trace(const Ray<double>& ray, int level, double weight, const Surface* from = nullptr) const {
     if (glass_mode)
-      return opt.float32_colour ? trace_glass<true>(ray, level, false, weight, from, {})
-                                : trace_glass<false>(ray, level, false, weight, from, {});
+      return opt.float32_colour ? trace_glass<true>(ray, level, false, weight, from, camera_interiors)
+                                : trace_glass<false>(ray, level, false, weight, from, camera_interiors);
     if (level > scene.max_depth) return {0, 0, 0};
     const auto hit = intersect_from(ray, from, level == 1 && !from);
     if (!hit) return scene.background;
@@ -1292,8 +1292,21 @@ struct Tracer::Impl {
   std::vector<double> object_ior;   // each object's interior ior (POV: one per object)
   std::vector<char> object_opaque;  // POV's OPAQUE_FLAG: no material lets light through
 
+  // The objects the camera is inside, in object order (POV's
+  // InitRayContainerState: Sphere::Inside |P - C|^2 < r^2, Plane::Inside
+  // N.P - offset < 1e-10; a mesh2 without an inside_vector is never inside).
+  std::vector<int> camera_interiors;
+
   void init_glass() {
     glass_mode = opt.pov_lighting;
+    const Vec3d cam = scene.camera.position;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      const Object& o = scene.objects[i];
+      const Vec3d oc = o.sphere.center - cam;
+      if ((o.kind == Object::Kind::sphere && dot(oc, oc) < o.sphere.radius * o.sphere.radius) ||
+          (o.kind == Object::Kind::plane && dot(cam, o.plane.normal) - o.plane.offset < glass::kEpsilon))
+        camera_interiors.push_back(int(i));
+    }
     object_ior.assign(scene.objects.size(), 1.0);
     object_opaque.assign(scene.objects.size(), 1);
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {

@@ -104,8 +104,11 @@ TEST(GlassScene, MtlDissolveIorAndIllumMapOntoTheMaterial) {
   std::ofstream(dir / "g.obj") << "mtllib g.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl g\nf 1 2 3\nusemtl t\nf 1 3 2\n";
   std::ofstream(dir / "s.json") << R"({"objects": [{"mesh": "g.obj"}]})";
   const Scene s = load_scene(dir / "s.json");
-  const auto& mats = s.objects[0].mesh->materials;
-  ASSERT_EQ(mats.size(), 2u);
+  // The set's materials as its triangles use them (a default one may lead).
+  const auto& set = *s.objects[0].mesh;
+  ASSERT_EQ(set.triangles.size(), 2u);
+  const std::vector<Material> mats{set.materials[std::size_t(set.triangles[0].material)],
+                                   set.materials[std::size_t(set.triangles[1].material)]};
   EXPECT_DOUBLE_EQ(mats[0].transmit, 0.75);  // Tr 0.75: d = 0.25, transmit 1 - d
   EXPECT_EQ(mats[0].filter, 0);
   EXPECT_EQ(mats[0].ior, 1.45);
