@@ -67,6 +67,16 @@ Vec3d pov_perp(const Vec3d& p1, const Vec3d& p2, const Vec3d& p3) {
 
 }  // namespace
 
+Vec3d pov_mesh_flat_normal(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d p1 = to_float32(a), p2 = to_float32(b), p3 = to_float32(c);
+  const Vec3d v1 = p2 - p1, v2 = p3 - p1;
+  Vec3d n = cross(v2, v1);
+  const double len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+  if (!(len > 0)) return {0, 0, 0};
+  n = n * (1.0 / len);
+  return to_float32(n);
+}
+
 PovMeshHit pov_mesh_hit(const Ray<double>& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   PovMeshHit out;
   // Compute_Mesh_Triangle: the plane, from the float vertices in double, then

@@ -60,6 +60,12 @@ std::array<double, 2> pov_mesh_uv(const Vec3d& p, const Vec3d& a, const Vec3d& b
                                   const std::array<double, 2>& ua, const std::array<double, 2>& ub,
                                   const std::array<double, 2>& uc);
 
+// The normal POV-Ray shades a flat mesh2 triangle with: computed in
+// Compute_Mesh_Triangle as (C - A) x (B - A) of the float32 vertices, times
+// 1/length, and stored as float32 (Mesh_Hash_Normal); Mesh::Normal returns
+// it as it is. Zero for a degenerate triangle.
+Vec3d pov_mesh_flat_normal(const Vec3d& a, const Vec3d& b, const Vec3d& c);
+
 std::optional<double> pov_mesh_intersect(const Ray<double>& r, const Vec3d& a, const Vec3d& b, const Vec3d& c);
 
 }  // namespace ra

@@ -15,6 +15,7 @@
 #include <type_traits>
 
 #include "shading/bump.h"
+#include "shading/glass.h"
 #include "accel/bounding_sphere.h"
 #include "accel/bvh.h"
 #include "scene/camera.h"
@@ -211,6 +212,7 @@ struct Tracer::Impl {
       }
     }
     build_object_bvh();
+    init_glass();
     one_mesh_tri4 = avx2 && s.objects.size() == 1 && s.objects[0].kind == Object::Kind::mesh && !opt.pov_mesh_intersect &&
                     (opt.use_double ? !meshes_d[0].tri4.empty() : !meshes_f[0].tri4.empty());
     for (const Object& obj : s.objects) {
@@ -1041,6 +1043,8 @@ struct Tracer::Impl {
         const Vec3d gn = unit_normal(a, b, c);
         s.ng = gn;
         s.n = gn;
+        if (opt.pov_flat_normal && set.shading == Shading::flat)
+          if (const Vec3d pn = pov_mesh_flat_normal(a, b, c); dot(pn, pn) > 0) s.n = pn;
         if (set.shading == Shading::smooth) {
           Vec3d n;
           if (tri.n[0] >= 0 && tri.n[1] >= 0 && tri.n[2] >= 0) {
@@ -1200,6 +1204,9 @@ struct Tracer::Impl {
   }
 
   Color trace(const Ray<double>& ray, int level, double weight, const Surface* from = nullptr) const {
+    if (glass_mode)
+      return opt.float32_colour ? trace_glass<true>(ray, level, false, weight, from, camera_interiors)
+                                : trace_glass<false>(ray, level, false, weight, from, camera_interiors);
     if (level > scene.max_depth) return {0, 0, 0};
     const auto hit = intersect_from(ray, from, level == 1 && !from);
     if (!hit) return scene.background;
@@ -1274,6 +1281,207 @@ struct Tracer::Impl {
       out = f(out + f(mul(refl, r)));
     }
     return out;
+  }
+
+  // ---- Transparency, refraction and Fresnel (renderer/shading/glass.h) ----
+  // A scene with a material that lets light through (filter, transmit) or
+  // reflects by Fresnel is shaded by POV-Ray 3.7's ComputeLightedTexture in
+  // full (one texture layer); any other scene by the shading above, which
+  // gives the same image for it and whose bits the goldens hold.
+  bool glass_mode = false;
+  std::vector<double> object_ior;   // each object's interior ior (POV: one per object)
+  std::vector<char> object_opaque;  // POV's OPAQUE_FLAG: no material lets light through
+
+  // The objects the camera is inside, in object order (POV's
+  // InitRayContainerState: Sphere::Inside |P - C|^2 < r^2, Plane::Inside
+  // N.P - offset < 1e-10; a mesh2 without an inside_vector is never inside).
+  std::vector<int> camera_interiors;
+
+  void init_glass() {
+    glass_mode = opt.pov_lighting;
+    const Vec3d cam = scene.camera.position;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      const Object& o = scene.objects[i];
+      const Vec3d oc = o.sphere.center - cam;
+      if ((o.kind == Object::Kind::sphere && dot(oc, oc) < o.sphere.radius * o.sphere.radius) ||
+          (o.kind == Object::Kind::plane && dot(cam, o.plane.normal) - o.plane.offset < glass::kEpsilon))
+        camera_interiors.push_back(int(i));
+    }
+    object_ior.assign(scene.objects.size(), 1.0);
+    object_opaque.assign(scene.objects.size(), 1);
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+      auto visit = [&](const Material& m) {
+        const bool clear = m.filter > 0 || m.transmit > 0;
+        if (clear) object_opaque[i] = 0;
+        if (clear || m.fresnel || opt.pov_lighting) glass_mode = true;
+        if (m.ior != 1 && object_ior[i] == 1) object_ior[i] = m.ior;
+      };
+      const Object& o = scene.objects[i];
+      if (o.kind == Object::Kind::mesh)
+        for (const Material& m : o.mesh->materials) visit(m);
+      else
+        visit(o.material);
+    }
+  }
+
+  template <bool F32>
+  static Color round_colour(const Color& x) {
+    if constexpr (F32) return to_float32(x); else return x;
+  }
+  template <bool F32>
+  static double round_scalar(double x) {
+    if constexpr (F32) return to_float32(x); else return x;
+  }
+
+  // POV's TraceRay. `level`: the trace level of the surface this ray meets
+  // (camera rays 1); a continued ray (through an interface of equal iors)
+  // keeps its parent's level, as POV's continuedRay does not count. POV
+  // returns black when the parent's level has reached max_trace_level or
+  // the ray's weight is below adc_bailout.
+  template <bool F32>
+  Color trace_glass(const Ray<double>& ray, int level, bool continued, double weight, const Surface* from,
+                    const std::vector<int>& interiors) const {
+    if ((continued ? level : level - 1) >= scene.max_depth || weight < scene.adc_bailout) return {0, 0, 0};
+    const auto hit = intersect_from(ray, from, level == 1 && !from);
+    if (!hit) return scene.background;
+    Surface s = surface(ray, *hit);
+    // POV's camera rays are unit; its refracted ones are left as Heckbert's
+    // formula makes them.
+    const Vec3d D = from ? ray.d : normalize(ray.d);
+    bump_document(s);
+    if (dot(s.n, D) > 0) s.n = -s.n;
+    bump_pov_after_flip(s);
+    return shade_glass<F32>(ray, s, D, level, weight, interiors);
+  }
+
+  // VNormalizeEq: times the reciprocal of the length.
+  static Vec3d pov_normalize(const Vec3d& v) { return v * (1.0 / length(v)); }
+
+  template <bool F32>
+  Color shade_glass(const Ray<double>& ray, const Surface& s, const Vec3d& D, int level, double weight,
+                    const std::vector<int>& interiors) const {
+    auto f = [](const Color& x) { return round_colour<F32>(x); };
+    auto fs = [](double x) { return round_scalar<F32>(x); };
+    auto ior_of = [&](int o) { return object_ior[std::size_t(o)]; };
+    const Material& m = *s.material;
+    const Color c = f(pigment(s));
+    const double fil = fs(m.filter), tr = fs(m.transmit);
+    const double att = fs(glass::opacity(fil, tr));
+    // ComputeReflectivity: standard (min = max) or Fresnel (min 0).
+    const double cos_i = -dot(D, s.n);
+    const Color rmax = f(m.reflection);
+    Color reflec = rmax;
+    if (m.fresnel)
+      if (const auto F = glass::fresnel(glass::relative_ior(interiors, s.object, ior_of), cos_i))
+        reflec = f(rmax * *F);
+    const double rweight = weight * max_component(reflec);
+    // Ambient, then each light's diffuse and phong, as POV sums them.
+    Color out = f(f(mul(f(mul(c, f(m.ambient))), f(scene.ambient_light))) * att);
+    const Vec3d refl = D - s.n * (2 * dot(D, s.n));
+    const double diffuse = fs(m.diffuse), phong = fs(m.phong), phong_size = fs(m.phong_size);
+    for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+      const PointLight& light = scene.lights[li];
+      const Vec3d lv = light.position - s.p;
+      const double dist = length(lv);
+      if (!(dist > 0)) continue;
+      const Vec3d l = lv * (1.0 / dist);  // VInverseScaleEq
+      const double nl = dot(s.n, l);
+      if (nl < kMinCosIncidence) continue;
+      const Color lc = shadow_glass<F32>(s, l, dist, level, li, f(light.color));
+      if (!(std::abs(lc.x) > glass::kEpsilon || std::abs(lc.y) > glass::kEpsilon || std::abs(lc.z) > glass::kEpsilon))
+        continue;
+      Color tl{0, 0, 0};
+      if (diffuse > 0) tl = f(mul(f(c * (nl * (diffuse * att))), lc));
+      if (phong > 0) {
+        const double rl = dot(refl, l);
+        if (rl > 0) {
+          // ComputePhongColour drops the highlight below 0.0008 from size 60 on.
+          const double in = (phong_size < 60 || rl > 0.0008) ? phong * std::pow(rl, phong_size) : 0.0;
+          tl = f(tl + f(lc * in));
+        }
+      }
+      out = f(out + tl);
+    }
+    // What passes (filCol), less what Fresnel reflects (conserve_energy).
+    Color filcol = glass::rgb_transm(c, fil, tr);
+    if constexpr (F32) filcol = f(Color{fs(fs(c.x * fil) + tr), fs(fs(c.y * fil) + tr), fs(fs(c.z * fil) + tr)});
+    if (m.fresnel)
+      filcol = f(mul(filcol, f(Color{std::min(1.0, 1.0 - reflec.x), std::min(1.0, 1.0 - reflec.y),
+                                     std::min(1.0, 1.0 - reflec.z)})));
+    const double trans = std::min(1.0, std::abs(fs(glass::greyscale(filcol))));
+    const Vec3d refl_dir = pov_normalize(refl);
+    bool tir = false;
+    if (trans > scene.adc_bailout) {
+      const double nw = weight * max_component(abs(filcol));
+      const glass::RefractionStep step = glass::refraction_step(interiors, s.object, ior_of);
+      Color rfr;
+      if (std::abs(step.ior - 1.0) < glass::kEpsilon) {
+        rfr = trace_glass<F32>(reflected_ray(s, D), level, true, nw, &s, step.interiors);
+      } else if (const auto dir = glass::refract(D, s.n, step.ior)) {
+        rfr = trace_glass<F32>(reflected_ray(s, *dir), level + 1, false, nw, &s, step.interiors);
+      } else {
+        // Total internal reflection: the reflected ray, unfiltered, in the
+        // ray's own interiors; the finish's reflection is then not added.
+        tir = true;
+        rfr = trace_glass<F32>(reflected_ray(s, refl_dir), level + 1, false, nw, &s, interiors);
+      }
+      out = tir ? f(out + rfr) : f(out + f(mul(rfr, filcol)));
+    }
+    if (!tir && (reflec.x != 0 || reflec.y != 0 || reflec.z != 0)) {
+      const Color r = trace_glass<F32>(reflected_ray(s, refl_dir), level + 1, false, rweight, &s, interiors);
+      out = f(out + f(mul(reflec, r)));
+    }
+    (void)ray;
+    return out;
+  }
+
+  // TracePointLightShadowRay with ComputeShadowColour: the light's colour
+  // times C filter + transmit of every transparent surface the shadow ray
+  // crosses (entering and leaving alike, unbent); an opaque object blocks.
+  template <bool F32>
+  Color shadow_glass(const Surface& s, const Vec3d& l, double dist, int level, std::size_t li, Color lc) const {
+    auto f = [](const Color& x) { return round_colour<F32>(x); };
+    auto fs = [](double x) { return round_scalar<F32>(x); };
+    int* cache = nullptr;
+    if (opt.pov_shadow_cache) {
+      int& level1 = shadow_cache_level1[li];
+      int& other = shadow_cache_other[li];
+      const int cached = (level == 1 && level1 >= 0) ? level1 : other;
+      if (cached >= 0 && closest<double>(Ray<double>{s.p, l, kPovMinIsectDepth, dist}, cached)) return {0, 0, 0};
+      cache = level == 1 ? &level1 : &other;
+    }
+    bool through = false;
+    Ray<double> r = shadow_ray(s, l, dist);
+    double depth = dist;
+    for (;;) {
+      const auto h = intersect(r, false);
+      if (!h) return lc;
+      if (object_opaque[std::size_t(h->object)]) {
+        if (cache && !through) *cache = h->object;
+        return {0, 0, 0};
+      }
+      const Surface hs = surface(r, *h);
+      const Material& hm = *hs.material;
+      const Color c = f(pigment(hs));
+      const double fil = fs(hm.filter), tr = fs(hm.transmit);
+      Color pass = glass::rgb_transm(c, fil, tr);
+      if constexpr (F32) pass = Color{fs(fs(c.x * fil) + tr), fs(fs(c.y * fil) + tr), fs(fs(c.z * fil) + tr)};
+      lc = f(mul(lc, pass));
+      if (!(std::abs(lc.x) >= glass::kEpsilon || std::abs(lc.y) >= glass::kEpsilon || std::abs(lc.z) >= glass::kEpsilon))
+        return {0, 0, 0};
+      through = true;
+      depth -= h->t;
+      r = shadow_ray(hs, l, depth);
+    }
+  }
+
+  // A shadow ray from s toward the light at distance dist, in the tracer's
+  // precision, as a double ray.
+  Ray<double> shadow_ray(const Surface& s, const Vec3d& l, double dist) const {
+    if (opt.use_double) return spawn_ray<double>(opt.self_intersection, s.p, s.p_error, s.ng, l, true, dist);
+    const Ray<float> r =
+        spawn_ray<float>(opt.self_intersection, Vec3f(s.p), Vec3f(s.p_error), Vec3f(s.ng), Vec3f(l), true, float(dist));
+    return Ray<double>{Vec3d(r.o), l, double(r.tmin), double(r.tmax)};
   }
 
   Color pixel(int i, int j) const {

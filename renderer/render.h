@@ -75,6 +75,17 @@ struct RenderOptions {
   // angle), skipped: whether it happens is decided by the last bits of the
   // hit point, which POV-Ray computes differently. A hypothesis for --explain.
   bool skip_rounding_self_hits = false;
+  // Shade every surface by POV-Ray 3.7's ComputeLightedTexture as the glass
+  // path does (renderer/shading/glass.h), also in a scene without glass:
+  // the light's direction as (L - P) times 1/|L - P| (VInverseScaleEq), each
+  // light's diffuse and phong summed before they join the total, and the
+  // phong highlight dropped where R.L <= 0.0008 from phong_size 60 on. The
+  // same image up to the last bits of a colour. A hypothesis for --explain.
+  bool pov_lighting = false;
+  // A flat mesh triangle shaded with POV-Ray's float32 face normal
+  // (renderer/pov_mesh.h, pov_mesh_flat_normal) instead of ours in double.
+  // A hypothesis for --explain.
+  bool pov_flat_normal = false;
 };
 
 // What a ray hit: object index, primitive (triangle) index, t and the

@@ -79,6 +79,9 @@ struct MtlMaterial {
   Vec3d Ka{0, 0, 0}, Kd{0.8, 0.8, 0.8}, Ks{0, 0, 0};
   double Ns = 0, Ni = 1, d = 1;  // d: opacity; `Tr t` sets d = 1 - t unless `d` is given
   int illum = 2;
+  Vec3d Tf{1, 1, 1};  // transmission filter
+  bool has_Tf = false;
+  std::string Ni_at;  // "m.mtl:5: Ni": where Ni was given, for errors about it
   std::string map_Ka, map_Kd, map_Ks, map_d, map_bump;
   // Where map_Kd and map_bump were named ("m.mtl:7: map_Kd 'tex.png'"), for errors
   // met when the image is read later.

@@ -1,8 +1,9 @@
-// Wavefront MTL reader: newmtl, Ka, Kd, Ks, Ns, Ni, d, Tr, illum and the
+// Wavefront MTL reader: newmtl, Ka, Kd, Ks, Ns, Ni, d, Tr, Tf, illum and the
 // maps map_Ka, map_Kd, map_Ks, map_d, map_bump (also `bump`, `map_Bump`).
 // Keywords are matched case-insensitively (exporters differ). Decisions:
 // - `Tr t` means d = 1 - t, unless the material also has `d` (which wins:
-//   some exporters write both, with Tr already inverted).
+//   some exporters write both, with Tr already inverted). d and Tr outside
+//   0..1 are errors at their line.
 // - Ka/Kd/Ks with one value mean grey (r = g = b); `spectral` / `xyz`
 //   forms are ignored with a warning.
 // - Map statements: the known options (-blendu -blendv -boost -mm -o -s -t
@@ -192,15 +193,26 @@ struct MtlParser {
     if (kw(k, p, "Kd")) return color(m.Kd, p, se, line, "Kd");
     if (kw(k, p, "Ks")) return color(m.Ks, p, se, line, "Ks");
     if (kw(k, p, "Ns")) return void(m.Ns = scalar(p, se, line, "Ns"));
-    if (kw(k, p, "Ni")) return void(m.Ni = scalar(p, se, line, "Ni"));
+    if (kw(k, p, "Ni")) {
+      m.Ni = scalar(p, se, line, "Ni");
+      m.Ni_at = located(name, line, "Ni");
+      return;
+    }
     if (kw(k, p, "d")) {
       m.d = scalar(p, se, line, "d");
+      if (!(m.d >= 0 && m.d <= 1)) w.fail(line, "d (opacity) must be between 0 and 1");
       has_d.back() = true;
       return;
     }
     if (kw(k, p, "Tr")) {
       const double t = scalar(p, se, line, "Tr");
+      if (!(t >= 0 && t <= 1)) w.fail(line, "Tr (transparency, 1 - d) must be between 0 and 1");
       if (!has_d.back()) m.d = 1 - t;
+      return;
+    }
+    if (kw(k, p, "Tf")) {
+      color(m.Tf, p, se, line, "Tf");
+      m.has_Tf = true;
       return;
     }
     if (kw(k, p, "illum")) {

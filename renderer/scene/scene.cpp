@@ -169,6 +169,13 @@ Material parse_material(const json& j, const std::string& path, const std::files
   m.phong = r.number("phong", m.phong);
   m.phong_size = r.number("phong_size", m.phong_size);
   m.reflection = r.color("reflection", m.reflection);
+  m.filter = r.number("filter", m.filter);
+  if (!(m.filter >= 0 && m.filter <= 1)) r.fail(r.at("filter"), "must be between 0 and 1");
+  m.transmit = r.number("transmit", m.transmit);
+  if (!(m.transmit >= 0 && m.transmit <= 1)) r.fail(r.at("transmit"), "must be between 0 and 1");
+  m.ior = r.number("ior", m.ior);
+  if (!(m.ior > 0)) r.fail(r.at("ior"), "must be greater than 0");
+  m.fresnel = r.boolean("fresnel", m.fresnel);
   if (r.has("texture")) {
     const json& t = r.get("texture");
     ImageTexture tex;

@@ -57,6 +57,19 @@ struct Material {
   double phong = 0.0;
   double phong_size = 40.0;
   Color reflection{0, 0, 0};
+  // Light through the surface (POV-Ray's pigment filter and transmit, 0..1):
+  // transmit passes it untinted, filter tinted by the pigment. The surface's
+  // own light (ambient, diffuse) is scaled by 1 - filter - transmit; what
+  // passes is C filter + transmit per channel (renderer/shading/glass.h).
+  double filter = 0;
+  double transmit = 0;
+  // The interior's index of refraction (POV's interior { ior }): 1 bends
+  // nothing. A mesh has one interior: its first material's ior that is not 1.
+  double ior = 1;
+  // POV's reflection { 0, reflection fresnel on } with conserve_energy:
+  // reflection weighted by the Fresnel equations for the interior's ior,
+  // transmission by 1 - that reflectivity.
+  bool fresnel = false;
   std::optional<ImageTexture> texture;  // replaces `color` where the object has UVs
   std::optional<BumpMap> bump;
 };

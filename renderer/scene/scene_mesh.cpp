@@ -36,6 +36,36 @@ Material material_from_mtl(const MtlMaterial& m, std::vector<std::string>* warni
                         ", so POV's ambient (a multiple of the pigment) cannot express it; dropped");
   out.phong = (m.Ks.x + m.Ks.y + m.Ks.z) / 3;
   out.phong_size = m.Ns;
+  // Transparency (the MTL specification's dissolve d; Tr = 1 - d) is POV's
+  // transmit, untinted; with a transmission filter Tf that is not white it
+  // is POV's filter, which tints by the pigment (Kd): POV has no separate
+  // filter colour, so a Tf unlike Kd is said in a warning.
+  const double clear = 1 - m.d;
+  if (clear > 0) {
+    const bool tinted = m.has_Tf && !(m.Tf.x == 1 && m.Tf.y == 1 && m.Tf.z == 1);
+    if (tinted) {
+      out.filter = clear;
+      if (warnings && !(m.Tf.x == m.Kd.x && m.Tf.y == m.Kd.y && m.Tf.z == m.Kd.z))
+        warnings->push_back("material \"" + m.name +
+                            "\": Tf differs from Kd; POV's filter tints by the pigment, so Kd tints what passes");
+    } else {
+      out.transmit = clear;
+    }
+  }
+  // illum 4 to 7 (ray-traced reflection, with transparency; 5 and 7 by
+  // Fresnel; 6 and 7 refract): reflection = Ks, fresnel for 5 and 7, the
+  // interior's ior = Ni for 6 and 7.
+  if (m.illum >= 4 && m.illum <= 7) {
+    out.reflection = m.Ks;
+    out.fresnel = m.illum == 5 || m.illum == 7;
+    if (m.illum == 6 || m.illum == 7) {
+      if (!(m.Ni > 0 && m.Ni <= 1e30))
+        throw InputError((m.Ni_at.empty() ? "material \"" + m.name + "\"" : m.Ni_at) +
+                         ": an index of refraction must be greater than 0 (illum " + std::to_string(m.illum) +
+                         " refracts by Ni)");
+      out.ior = m.Ni;
+    }
+  }
   if (!m.map_Kd.empty() && std::filesystem::exists(m.map_Kd))
     out.texture = ImageTexture{m.map_Kd, TextureFilter::bilinear, m.map_Kd_at};
   if (!m.map_bump.empty() && std::filesystem::exists(m.map_bump))

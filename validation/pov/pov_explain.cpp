@@ -149,6 +149,16 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
   f32_only.float32_colour = true;
   RenderOptions no_self_hit = quiet;
   no_self_hit.skip_rounding_self_hits = true;
+  RenderOptions pov_light = quiet;
+  pov_light.pov_lighting = true;
+  RenderOptions pov_light_f32 = pov_light;
+  pov_light_f32.float32_colour = true;
+  RenderOptions pov_light_mesh = pov_f32;
+  pov_light_mesh.pov_lighting = true;
+  RenderOptions flat_normal = pov_f32;
+  flat_normal.pov_flat_normal = true;
+  RenderOptions flat_normal_light = pov_light_mesh;
+  flat_normal_light.pov_flat_normal = true;
   struct Model {
     const char* cause;
     Scene scene;
@@ -191,6 +201,26 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
        "origin allows (at a grazing angle far away the hit point's last bits put it on one side of the surface or "
        "the other, and POV-Ray computes them differently); without that self-hit our pixel equals POV-Ray's",
        scene, no_self_hit},
+      {"POV lighting: POV-Ray's ComputeLightedTexture takes the light's direction as (L - P) times 1/|L - P| "
+       "(VInverseScaleEq), not divided by |L - P|, sums each light's diffuse and phong before adding them, and "
+       "drops a highlight where R.L <= 0.0008 from phong_size 60 on (trace.cpp); shaded so, our pixel equals POV-Ray's",
+       scene, pov_light},
+      {"POV lighting in float32: POV-Ray's ComputeLightedTexture as above (the light's direction times 1/|L - P|, "
+       "each light's diffuse and phong summed first) with its colours in float32 (RGBColour); shaded so, our pixel "
+       "equals POV-Ray's",
+       scene, pov_light_f32},
+      {"POV lighting in float32 with every mesh2 rule: POV-Ray's ComputeLightedTexture as above in float32, at "
+       "its mesh2 hit point with its inside test, float32 mesh data and equal normals flat; shaded so, our pixel "
+       "equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), pov_light_mesh},
+      {"flat mesh2 normal: POV-Ray shades a flat mesh2 triangle with its face normal (C - A) x (B - A) of the "
+       "float32 vertices, times 1/length, stored as float32 (Compute_Mesh_Triangle, Mesh_Hash_Normal); shaded so, "
+       "with every mesh2 rule and float32 colours, our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), flat_normal},
+      {"flat mesh2 normal with POV lighting: POV-Ray's float32 face normal of a flat mesh2 triangle, its "
+       "ComputeLightedTexture (the light's direction times 1/|L - P|, each light's terms summed first), every mesh2 "
+       "rule and float32 colours; shaded so, our pixel equals POV-Ray's",
+       as_pov_stores_it(scene, true, true), flat_normal_light},
   };
   std::vector<std::unique_ptr<Tracer>> model_tracers;
   for (const auto& m : models) model_tracers.push_back(std::make_unique<Tracer>(m.scene, m.options));

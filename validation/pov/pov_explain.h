@@ -19,6 +19,10 @@
 //  - mesh2 UV: texture coordinates by POV's Mesh::UVCoord at its hit point.
 //  - float32 shading: every colour of the shading rounded to float32, as
 //    POV's RGBColour is float (with all the mesh2 rules, and alone).
+//  - POV lighting: every surface shaded by POV's ComputeLightedTexture as the
+//    glass path does (RenderOptions::pov_lighting: the light's direction
+//    times 1/|L - P|, each light's terms summed first, the phong cut-off),
+//    in double and in float32.
 //  - rounding self-hit: a reflected ray meeting the primitive it leaves
 //    within the rounding of its origin (grazing, far out), skipped.
 //  - shadow cache: POV first re-tests the object that last blocked a light

@@ -40,10 +40,35 @@ std::string vec(const Vec3d& v) { return "<" + num(v.x) + "," + num(v.y) + "," +
 std::string rgb(const Color& c) { return "rgb " + vec(c); }
 
 // Every finish term is written, so POV's defaults never apply silently.
+// Fresnel: POV's reflection { min, max fresnel on } with min 0 and
+// conserve_energy (transmission less what is reflected).
 std::string finish(const Material& m) {
+  const std::string reflection =
+      m.fresnel ? "reflection { rgb 0, " + rgb(m.reflection) + " fresnel on } conserve_energy" : "reflection { " + rgb(m.reflection) + " }";
   return "finish { ambient " + rgb(m.ambient) + " diffuse " + num(m.diffuse) + " brilliance 1 phong " +
-         num(m.phong) + " phong_size " + num(m.phong_size) + " specular 0 reflection { " + rgb(m.reflection) +
-         " } }";
+         num(m.phong) + " phong_size " + num(m.phong_size) + " specular 0 " + reflection + " }";
+}
+
+// The pigment's filter and transmit (rgbft), only where light passes, so an
+// opaque material's SDL stays as it was.
+bool clear(const Material& m) { return m.filter != 0 || m.transmit != 0; }
+std::string colour(const Material& m) {
+  if (!clear(m)) return rgb(m.color);
+  return "rgbft <" + num(m.color.x) + "," + num(m.color.y) + "," + num(m.color.z) + "," + num(m.filter) + "," +
+         num(m.transmit) + ">";
+}
+
+// POV's interior is one per object: a mesh's is its first material's ior
+// that is not 1 (as the renderer's).
+double object_ior(const Object& o) {
+  if (o.kind != Object::Kind::mesh) return o.material.ior;
+  for (const Material& m : o.mesh->materials)
+    if (m.ior != 1) return m.ior;
+  return 1;
+}
+std::string interior(const Object& o) {
+  const double ior = object_ior(o);
+  return ior == 1 ? "" : "  interior { ior " + num(ior) + " }\n";
 }
 
 // Names of the images the SDL refers to, one per distinct source file.
@@ -69,12 +94,13 @@ class ImageNames {
 // POV's texture for a material. `with_uv`: the surface has UVs, so the image
 // texture and the bump map apply (our tracer uses them only there).
 std::string texture(const Material& m, bool with_uv, ImageNames& names) {
-  std::string pigment = "pigment { " + rgb(m.color) + " }";
+  std::string pigment = "pigment { " + colour(m) + " }";
   std::string normal;
   if (with_uv && m.texture) {
     // gamma 1.0: the PNG's values are linear (else POV decodes them as sRGB).
     pigment = "pigment { image_map { png " + pov_string_literal(names.name_of(m.texture->file)) + " gamma 1.0" +
-              (m.texture->filter == TextureFilter::bilinear ? " interpolate 2" : "") + " } }";
+              (m.texture->filter == TextureFilter::bilinear ? " interpolate 2" : "") +
+              (clear(m) ? " filter all " + num(m.filter) + " transmit all " + num(m.transmit) : "") + " } }";
   }
   if (with_uv && m.bump) {
     // Only the pov variant gets here (pov_inexpressible); POV does not
@@ -95,7 +121,7 @@ std::string idx3(int a, int b, int c) {
 // POV computes each face normal from its vertices as we do; smooth sets get
 // the set's normals and, for triangles without normal indices, the
 // area-weighted vertex normals.
-void write_mesh2(std::ostringstream& out, const TriangleSet& set, ImageNames& names) {
+void write_mesh2(std::ostringstream& out, const TriangleSet& set, ImageNames& names, const std::string& modifiers) {
   if (set.triangles.empty()) {
     // POV-Ray refuses a mesh2 without faces ("Cannot parse input"); our
     // tracer sees nothing there either (an OBJ of points or lines).
@@ -169,7 +195,7 @@ void write_mesh2(std::ostringstream& out, const TriangleSet& set, ImageNames& na
       out << ",\n    " << (has(tri.t) ? idx3(tri.t[0], tri.t[1], tri.t[2]) : idx3(0, 0, 0));
     out << " }\n  uv_mapping\n";
   }
-  out << "}\n";
+  out << modifiers << "}\n";
 }
 
 std::optional<std::string> material_inexpressible(const Material& m) {
@@ -213,6 +239,9 @@ std::optional<std::string> pov_inexpressible(const Scene& scene) {
       continue;
     }
     for (const auto& m : o.mesh->materials) {
+      if (m.ior != 1 && m.ior != object_ior(o))
+        return "mesh " + std::filesystem::path(o.mesh->name).filename().string() +
+               " has materials of different ior, and POV-Ray's mesh2 has one interior";
       if (auto r = material_inexpressible(m)) return r;
       if (auto r = float_images(m, seen)) return r;
     }
@@ -259,14 +288,14 @@ PovExport export_pov(const Scene& scene, const std::string& image_prefix) {
     switch (o.kind) {
       case Object::Kind::sphere:
         out << "sphere { " << vec(o.sphere.center) << ", " << num(o.sphere.radius) << "\n  "
-            << texture(o.material, false, names) << " }\n";
+            << texture(o.material, false, names) << (interior(o).empty() ? "" : "\n" + interior(o)) << " }\n";
         break;
       case Object::Kind::plane:
         out << "plane { " << vec(o.plane.normal) << ", " << num(o.plane.offset) << "\n  "
-            << texture(o.material, false, names) << " }\n";
+            << texture(o.material, false, names) << (interior(o).empty() ? "" : "\n" + interior(o)) << " }\n";
         break;
       case Object::Kind::mesh:
-        write_mesh2(out, *o.mesh, names);
+        write_mesh2(out, *o.mesh, names, interior(o));
         break;
     }
   }

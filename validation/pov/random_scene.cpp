@@ -69,7 +69,13 @@ class Draw {
   Draw(std::uint64_t seed, int index) {
     std::seed_seq seq{std::uint32_t(seed), std::uint32_t(seed >> 32), std::uint32_t(index)};
     rng_.seed(seq);
+    // Glass is drawn from a stream of its own, so that a seed's scene is
+    // the same as before glass existed, with some materials made glass.
+    std::seed_seq glass_seq{std::uint32_t(seed), std::uint32_t(seed >> 32), std::uint32_t(index), 0x6c617373u};
+    glass_.seed(glass_seq);
   }
+  double glass_uniform(double lo, double hi) { return lo + (hi - lo) * std::generate_canonical<double, 53>(glass_); }
+  double glass_nice(double lo, double hi) { return std::round(glass_uniform(lo, hi) * 1000) / 1000; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * std::generate_canonical<double, 53>(rng_); }
   int integer(int lo, int hi) { return lo + int(rng_() % std::uint64_t(hi - lo + 1)); }  // inclusive
   bool chance(double p) { return uniform(0, 1) < p; }
@@ -90,6 +96,7 @@ class Draw {
 
  private:
   std::mt19937_64 rng_;
+  std::mt19937_64 glass_;
 };
 
 json to_json(const Vec3d& v) {
@@ -109,6 +116,18 @@ json material(Draw& d, bool with_uv) {
     m["phong_size"] = d.nice(1, 200);
   }
   if (d.chance(0.4)) m["reflection"] = d.chance(0.3) ? d.vec(0.05, 0.8) : json(d.nice(0.05, 0.8));
+  // One material in four lets light through: transmit and/or filter, an ior
+  // from 1 (no bending) to 2.4, Fresnel reflection in half of them.
+  if (d.glass_uniform(0, 1) < 0.25) {
+    const double kind = d.glass_uniform(0, 1);
+    if (kind < 0.7) m["transmit"] = d.glass_nice(0.3, 0.95);
+    if (kind > 0.4) m["filter"] = d.glass_nice(0.1, 1 - m.value("transmit", 0.0));
+    m["ior"] = d.glass_uniform(0, 1) < 0.2 ? 1.0 : d.glass_nice(1.05, 2.4);
+    if (d.glass_uniform(0, 1) < 0.5) {
+      m["fresnel"] = true;
+      m["reflection"] = d.glass_nice(0.3, 1);
+    }
+  }
   if (with_uv && d.chance(0.6)) {
     const auto tex = random_scene_textures();
     if (!tex.empty())
