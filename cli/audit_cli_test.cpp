@@ -133,6 +133,8 @@ TEST(AuditCli, ExportThenAuditAgreesOnEveryVerdict) {
   const auto j = nlohmann::json::parse(slurp(json));
   std::ifstream in(csv);
   std::string line;
+  std::getline(in, line);  // the stamp: # rayaudit-cases ...
+  ASSERT_EQ(line.rfind("# rayaudit-cases ", 0), 0u) << line;
   std::getline(in, line);  // header: ...,verdict,t
   std::size_t i = 0;
   while (std::getline(in, line)) {

@@ -140,7 +140,11 @@ def sweep_number(label):
 
 
 class Methods:
-    """The registry as rayaudit reports it: colours, and which are the documents'."""
+    """The registry as rayaudit reports it: colours, and which are the documents'.
+    Subjects that are not the registry's (users' graded or API runs) get
+    colours of their own and the label "(yours)" in every chart and legend."""
+
+    USER_COLOURS = ["#e6007e", "#00a6a6", "#8c564b", "#6a3d9a", "#b15928", "#1f1f1f"]
 
     def __init__(self, methods):
         self.by_name = {m["name"]: m for m in methods}
@@ -152,13 +156,22 @@ class Methods:
             self.colour[n] = cmap(i % 10)
         for i, n in enumerate(sph):
             self.colour[n] = cmap((i + 4) % 10)
+        self.users = []
+
+    def add_user(self, name):
+        if name not in self.by_name and name not in self.users:
+            self.colour[name] = self.USER_COLOURS[len(self.users) % len(self.USER_COLOURS)]
+            self.users.append(name)
+
+    def is_user(self, name):
+        return name in self.users
 
     def is_document(self, name):
         m = self.by_name.get(name)
         return bool(m) and m["source"].startswith("seeds/")
 
     def label(self, name):
-        return name + (" (doc)" if self.is_document(name) else "")
+        return name + (" (doc)" if self.is_document(name) else "") + (" (yours)" if self.is_user(name) else "")
 
 
 def bench_rows(bench):
@@ -192,7 +205,7 @@ def parse_bench_name(name):
 # ---------------------------------------------------------------- section 1 --
 
 
-def speed_accuracy(audit, bench, methods):
+def speed_accuracy(audit, bench, methods, timings=None):
     rows = bench_rows(bench)
     ns = {}
     for name, b in rows.items():
@@ -210,7 +223,7 @@ def speed_accuracy(audit, bench, methods):
             "precision": s["precision"],
             "kind": s["kind"],
             "document_variant": methods.is_document(s["method"]),
-            "ns_per_test": ns.get((s["method"], s["precision"])),
+            "ns_per_test": ns.get((s["method"], s["precision"]), (timings or {}).get(s["name"])),
             "wrong_pct": t["wrong_pct"],
             "leaks": t.get("leaks", 0),
             "groups": groups,
@@ -235,11 +248,16 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
     for e, (x, y) in zip(entries, pts):
         doc = e["document_variant"]
         c = methods.colour.get(e["method"], "k")
-        ax.scatter([x], [y], s=60, marker="*" if e.get("peer") else "o" if e["precision"] == "float" else "s",
-                   facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=3)
-        ax.annotate(("doc: " if doc else "peer: " if e.get("peer") else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d"),
-                    (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6.5,
-                    color=c, alpha=0.9)
+        user = methods.is_user(e["method"])
+        ax.scatter([x], [y], s=140 if user else 60,
+                   marker="*" if user or e.get("peer") else "o" if e["precision"] == "float" else "s",
+                   facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=4 if user else 3)
+        ax.annotate(("doc: " if doc else "peer: " if e.get("peer") else "yours: " if user else "") + e["method"] +
+                    ("/f" if e["precision"] == "float" else "/d"),
+                    (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7.5 if user else 6.5,
+                    color=c, alpha=0.9, fontweight="bold" if user else "normal")
+    for name in dict.fromkeys(e["method"] for e in entries if methods.is_user(e["method"])):
+        ax.scatter([], [], s=140, marker="*", color=methods.colour[name], label=methods.label(name))
     front = pareto(pts)
     if len(front) > 1:
         ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, alpha=0.6,
@@ -648,6 +666,7 @@ def machine(ctx, audit, bench, stages):
         "versions": versions,
         "seed": audit.get("seed"),
         "rays_per_family": audit.get("rays_per_family"),
+        "audit_inputs": audit.get("_inputs", []),
         "stages": stages,
     }
 
@@ -692,6 +711,53 @@ window.addEventListener('load', function () {
 """
 
 
+def audit_words(m):
+    """The run's real seed and rays, and what each --audit file holds."""
+    inputs = m.get("audit_inputs") or []
+    generated = m["rays_per_family"] not in (None, 0)
+    text = (f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method x precision"
+            if generated else "graded answers on cases given by hand (not generated: no seed)")
+    if len(inputs) > 1 or any(i.get("graded") for i in inputs):
+        parts = []
+        for i in inputs:
+            what = ", ".join(i["subjects"])
+            if i.get("graded"):
+                g = i["graded"]
+                what += f" (answers {g.get('answers', '?')} on the cases {g.get('cases', '?')})"
+            parts.append(f"{os.path.basename(i['file'])}: {what}")
+        text += "; " + "; ".join(parts)
+    return text
+
+
+def merge_audits(paths):
+    """Several audits of the same seed and rays (rayaudit report checked) as one."""
+    merged = None
+    for p in paths:
+        a = load_json(p)
+        entry = {"file": p, "subjects": [s["name"] for s in a["subjects"]], "graded": a.get("graded")}
+        if merged is None:
+            merged = dict(a, subjects=list(a["subjects"]), cells=list(a["cells"]), _inputs=[entry])
+            continue
+        merged["subjects"] += a["subjects"]
+        merged["cells"] += a["cells"]
+        merged["_inputs"].append(entry)
+    return merged
+
+
+def read_timings(path):
+    """subject,ns_per_test (validation/baseline/timing.h) as {subject: ns}."""
+    current_input[0] = path
+    out = {}
+    with open(path, encoding="utf-8-sig") as f:
+        for line in f:
+            line = line.strip()
+            if not line or line.startswith("#") or line == "subject,ns_per_test":
+                continue
+            subject, ns = line.rsplit(",", 1)
+            out[subject] = float(ns)
+    return out
+
+
 def chart_html(svg, caption):
     return f'<div class="chart">{svg}</div><p class="cap">{esc(caption)}</p>'
 
@@ -710,7 +776,12 @@ def page(rep, charts, methods, uris):
         f = min(timed, key=lambda e: e["ns_per_test"])
         facts.append(f"Fastest triangle test: <b>{esc(f['subject'])}</b> at {fnum(f['ns_per_test'])} ns "
                      f"({fnum(f['wrong_pct'])}% wrong)")
-    if sa:
+    if len(sa) == 1:
+        # One subject is not "most right" of anything.
+        e = sa[0]
+        facts.append(f"One triangle subject: <b>{esc(methods.label(e['method']))}/{esc(e['precision'])}</b> "
+                     f"({fnum(e['wrong_pct'])}% wrong, {e['leaks']} leaks)")
+    elif sa:
         right = min(sa, key=lambda e: (e["leaks"] > 0, e["wrong_pct"], e["ns_per_test"] or 0))
         facts.append(f"Most right: <b>{esc(right['subject'])}</b> ({fnum(right['wrong_pct'])}% wrong, "
                      f"{right['leaks']} leaks)")
@@ -731,7 +802,7 @@ def page(rep, charts, methods, uris):
             ("Flags", f"{m['flags']} ({m['build_type']})"), ("rayaudit", f"{m['rayaudit']}, commit {m['commit']}"),
             ("Date", m["date"]),
             ("Libraries", ", ".join(f"{k} {v}" for k, v in m["versions"].items())),
-            ("Audit", f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method x precision")]
+            ("Audit", audit_words(m))]
     if m["bench_context"]:
         names = {"host_name": "host", "num_cpus": "CPUs", "mhz_per_cpu": "MHz",
                  "library_build_type": "Google Benchmark library built as", "date": "run at"}
@@ -876,8 +947,12 @@ def main():
     for k, v in ctx.get("fs_paths", {}).items():
         ctx[k] = [os.fsdecode(bytes.fromhex(h)) for h in v] if isinstance(v, list) else os.fsdecode(bytes.fromhex(v))
     methods = Methods(ctx["methods"])
-    audit = load_json(ctx["audit"])
+    audit = merge_audits(ctx.get("audits") or [ctx["audit"]])
     peer_subjects.register(methods, audit)
+    for s in audit["subjects"]:
+        if not peer_subjects.is_peer(methods, s["method"]):
+            methods.add_user(s["method"])
+    timings = read_timings(ctx["timings"]) if ctx.get("timings") else {}
     bench = None
     if ctx.get("bench"):
         bench = load_json(ctx["bench"])
@@ -899,7 +974,7 @@ def main():
 
     rep = {
         "have_bench": bench is not None,
-        "speed_accuracy": speed_accuracy(audit, bench, methods),
+        "speed_accuracy": speed_accuracy(audit, bench, methods, timings),
         "stability": stability(audit),
         "crack_maps": crack_maps(cm, cm_dir) if cm else [],
         "crack_meshes": cm["meshes"] if cm else [],
@@ -911,7 +986,7 @@ def main():
         "machine": machine(ctx, audit, bench, stages),
     }
     charts = {
-        "speed_accuracy": chart_speed_accuracy(rep["speed_accuracy"], methods, bench is not None),
+        "speed_accuracy": chart_speed_accuracy(rep["speed_accuracy"], methods, bench is not None or bool(timings)),
         "stability": chart_stability(rep["stability"], methods),
         "crack_leaks": chart_crack_leaks(rep["crack_maps"], methods) if rep["crack_maps"] else None,
         "optimisations": chart_optimisations(rep["optimisations"]) if bench else [],
