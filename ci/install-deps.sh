@@ -12,7 +12,7 @@ PACKAGES=(
   libembree-dev
   libtinyobjloader-dev
   libcli11-dev nlohmann-json3-dev
-  python3-matplotlib python3-numpy python3-pil
+  python3-matplotlib python3-numpy python3-pil python3-yaml
   chromium
   clang libclang-rt-14-dev clang-format
 )

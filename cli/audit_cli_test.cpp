@@ -130,6 +130,8 @@ TEST(AuditCli, ExportThenAuditAgreesOnEveryVerdict) {
   const auto j = nlohmann::json::parse(slurp(json));
   std::ifstream in(csv);
   std::string line;
+  std::getline(in, line);  // the stamp: # rayaudit-cases ...
+  ASSERT_EQ(line.rfind("# rayaudit-cases ", 0), 0u) << line;
   std::getline(in, line);  // header: ...,verdict,t
   std::size_t i = 0;
   while (std::getline(in, line)) {
@@ -540,7 +542,7 @@ TEST(AuditExportCli, ExportCasesStreamsWithinAFixedAddressSpace) {
   std::ifstream in(out);
   long lines = 0;
   for (std::string l; std::getline(in, l);) ++lines;
-  EXPECT_EQ(lines, 300001);
+  EXPECT_EQ(lines, 300002);  // the stamp, the header, the rows
   fs::remove(out);
 }
 

@@ -3,6 +3,7 @@
 // answers from any language (--grade), exports cases (--export-cases), merges shards (audit merge).
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,8 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
+#include "baseline/gate.h"
+#include "baseline/stamp.h"
 #include "exact/audit.h"
 #include "exact/cases_csv.h"
 #include "command.h"
@@ -46,6 +49,7 @@ struct Args {
   std::string numbers = "hex";  // --export-cases: hex or decimal
   std::string tracers;              // --tracers: whole tracers on closed meshes (validation/tracers)
   long long tracer_rays = 2000;     // --tracer-rays: per shape, placement and scale
+  std::string ids, baseline, junit;  // --ids (replay), --baseline BASE.json, --junit FILE
   long long rays = 200000;  // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
@@ -154,6 +158,34 @@ std::vector<std::string> chosen_families(const std::string& list) {
   return names;
 }
 
+std::string join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& x : v) out += (out.empty() ? "" : ",") + x;
+  return out;
+}
+
+// --ids: a case is chosen by its id, or by its ray's FAMILY:SWEEP:PROBE
+// (the ids failures name; an export id adds :K, the triangle of the group).
+struct IdFilter {
+  std::vector<std::string> wanted;
+  std::vector<char> matched;
+  explicit IdFilter(const std::string& list) : wanted(split_list(list, "--ids")), matched(wanted.size(), 0) {}
+  bool all() const { return wanted.empty(); }
+  bool take(const std::string& id) {
+    if (wanted.empty()) return true;
+    const auto colon = id.rfind(':');
+    bool hit = false;
+    for (std::size_t i = 0; i < wanted.size(); ++i)
+      if (wanted[i] == id || (colon != std::string::npos && wanted[i] == id.substr(0, colon))) hit = true, matched[i] = 1;
+    return hit;
+  }
+  // The first id no case had, as the one-line refusal.
+  void check(const std::string& file) const {
+    for (std::size_t i = 0; i < wanted.size(); ++i)
+      if (!matched[i]) throw ra::InputError("--ids: '" + wanted[i] + "' is not a case of " + file);
+  }
+};
+
 // 1234567 -> "1.23M": counts and rates at a glance.
 std::string si(double v) {
   const char* unit[] = {"", "k", "M", "G", "T"};
@@ -222,7 +254,9 @@ void audit_cases(const Args& a) {
   if (!a.csv.empty())
     throw ra::InputError("audit: --csv writes per-family rows, which --cases has none of; use --json");
   ra::OutputBatch outputs({a.json});
-  for_each_case(a.cases, [](const UserCase&, long) {});  // throws before anything is written
+  IdFilter ids(a.ids);
+  for_each_case(a.cases, [&](const UserCase& c, long) { ids.take(c.id); });  // throws before anything is written
+  ids.check(a.cases);
   std::vector<const ra::Method*> tri_methods;
   for (const ra::Method* m : chosen_methods(a.methods))
     if (m->kind == ra::Kind::triangle) tri_methods.push_back(m);
@@ -235,7 +269,28 @@ void audit_cases(const Args& a) {
     for (std::size_t i = 0; i < tri_methods.size(); ++i) std::printf(" %-11s", columns);
     std::printf("\n");
     long wrong = 0, n = 0;
+    // Rows of one exported ray (FAMILY:SWEEP:PROBE:K): a method that hits
+    // none of them where the exact answer crosses one leaks there, which no
+    // single row shows (each is a boundary case, never wrong alone).
+    struct Group {
+      std::string key;
+      bool crossed[2] = {false, false};   // by precision: f32, f64
+      std::map<std::string, bool> hit;    // METHOD/PRECISION -> any hit
+    } group;
+    auto end_group = [&] {
+      for (const auto& [subject, any] : group.hit) {
+        const bool f32 = subject.size() > 6 && subject.compare(subject.size() - 6, 6, "/float") == 0;
+        if (!any && group.crossed[f32 ? 0 : 1])
+          std::printf("  ray %s: %s hits none of its triangles where the exact answer crosses one: a leak\n",
+                      group.key.c_str(), subject.c_str());
+      }
+      group = Group{};
+    };
     for_each_case(a.cases, [&](const UserCase& c, long) {
+      if (!ids.take(c.id)) return;
+      const auto colon = c.id.rfind(':');
+      const std::string key = std::count(c.id.begin(), c.id.end(), ':') == 3 ? c.id.substr(0, colon) : std::string();
+      if (key != group.key) end_group(), group.key = key;
       const auto ans = ra::oracle::triangle(c.ray, c.tri.a, c.tri.b, c.tri.c);
       // Float answers are judged on the case rounded to float, what a float
       // method is given (the verdict can differ: a point 1 ulp off an edge
@@ -258,6 +313,12 @@ void audit_cases(const Args& a) {
           answers[m->name + "/" + precision_name(p)] = {{"hit", t.has_value()}, {"t", t ? t_json(*t) : nullptr}};
           // '!' marks an answer the exact verdict contradicts (boundary etc. never do).
           const auto verdict = p == Precision::f32 ? ans_f.verdict : ans.verdict;
+          const auto& exact = p == Precision::f32 ? ans_f : ans;
+          if (!key.empty()) {
+            group.crossed[p == Precision::f32 ? 0 : 1] |=
+                (verdict == ra::oracle::Verdict::hit || verdict == ra::oracle::Verdict::boundary) && exact.t > 0;
+            group.hit[m->name + "/" + precision_name(p)] |= t.has_value();
+          }
           const bool bad = (verdict == ra::oracle::Verdict::hit && !t) || (verdict == ra::oracle::Verdict::miss && t);
           wrong += bad;
           cell += std::string(t ? "hit" : "miss") + (bad ? "!" : "") + " ";
@@ -280,6 +341,7 @@ void audit_cases(const Args& a) {
       }
       ++n;
     });
+    end_group();
     std::printf("%ld case(s); %ld answer(s) contradict the exact verdict (marked !)\n", n, wrong);
     return n;
   };
@@ -300,22 +362,50 @@ void audit_cases(const Args& a) {
 // ----------------------------------------------------------- --grade ---
 void grade(const Args& a) {
   if (!a.methods.empty()) throw ra::InputError("audit: --grade grades the answers file, not --methods: drop --methods");
-  ra::OutputBatch outputs({a.json, a.csv});
+  if (!a.ids.empty()) throw ra::InputError("audit: --grade grades every answer; --ids goes with --cases alone (to show cases)");
+  ra::OutputBatch outputs({a.json, a.csv, a.junit});
+  const std::optional<nlohmann::json> base =
+      a.baseline.empty() ? std::nullopt : std::optional(ra::baseline::read_audit_json(a.baseline));
   const auto ps = chosen_precisions(a.precision);
-  // One file of answers is one precision (as --export-cases); double unless given.
+  // One file of answers is one precision (as --export-cases).
   if (a.precision_given && ps.size() != 1)
     throw ra::InputError("--precision: --grade takes one precision (float or double), got '" + a.precision + "'");
-  const Precision p = ps.size() == 1 ? ps[0] : Precision::f64;
+  // The cases' stamp: which run they are (version, seed, rays, families)
+  // and their precision, the default for the answers.
+  const std::optional<CasesStamp> stamp = read_stamp(a.cases);
+  if (stamp && stamp->version != RAYAUDIT_VERSION)
+    throw ra::InputError(ra::located(a.cases, 1, "exported by rayaudit " + stamp->version + ", this is " +
+                                                     RAYAUDIT_VERSION + ": export the cases again with this version"));
+  Precision p = Precision::f64;
+  if (a.precision_given) p = ps[0];
+  else if (stamp) p = stamp->precision == "float" ? Precision::f32 : Precision::f64;
+  else if (answers_look_float(a.grade, a.cases))
+    // Graded as double, float rounding would read as errors of 1e10 ulps.
+    throw ra::InputError("audit: every t in " + a.grade + " and every coordinate of " + a.cases +
+                         " is a float: give --precision float (or --precision double if your intersector "
+                         "computes in double)");
   const std::string method = std::filesystem::path(a.grade).stem().string();
-  const Report rep = grade_answers(a.grade, a.cases, p, method.empty() ? "answers" : method);
-  std::fputs(rep.summary_table().c_str(), stdout);
-  if (!a.json.empty()) {
-    nlohmann::json j = rep.to_json();
-    j["graded"] = {{"answers", a.grade}, {"cases", a.cases}};
-    ra::write_text_atomically(a.json, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  Report rep = grade_answers(a.grade, a.cases, p, method.empty() ? "answers" : method);
+  if (stamp) {
+    rep.seed = stamp->seed;
+    rep.rays = stamp->rays;
+    for (const Cell& c : rep.cells)
+      if (std::find(stamp->families.begin(), stamp->families.end(), c.family) == stamp->families.end())
+        throw ra::InputError(ra::located(a.cases, 1, "the stamp lists the families " + join(stamp->families) +
+                                                         ", but rows of family '" + c.family + "' follow"));
   }
+  std::fputs(rep.summary_table().c_str(), stdout);
+  nlohmann::json j = rep.to_json();
+  j["graded"] = {{"answers", a.grade}, {"cases", a.cases}};
+  if (stamp) j["graded"]["stamp"] = {{"version", stamp->version}, {"seed", stamp->seed}, {"rays", stamp->rays},
+                                     {"precision", stamp->precision}, {"families", stamp->families}};
+  const ra::baseline::GateResult g =
+      ra::baseline::gate(j, base, {.baseline_name = a.baseline, .junit = a.junit, .suite = "rayaudit audit --grade"});
+  if (!a.json.empty())
+    ra::write_text_atomically(a.json, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
+  if (g.rose) throw ra::CheckFailed("audit: worse than the baseline " + a.baseline + " (the rows marked ROSE)");
 }
 
 // --------------------------------------------------- --export-cases ---
@@ -336,17 +426,39 @@ void export_cases(const Args& a) {
   ra::declare_output(a.export_cases);
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
-  const auto fams = chosen_families(a.families);
+  auto fams = chosen_families(a.families);
   const ra::audit::Numbers numbers = a.numbers == "decimal" ? ra::audit::Numbers::decimal : ra::audit::Numbers::hex;
-  bool any = false;
-  for_each_export_row(fams, p, a.seed, 1, [&](const ra::audit::ExportRow&) { any = true; });
-  if (!any) throw ra::InputError("audit: --export-cases needs at least one triangle family other than secondary");
+  // A family asked for by name is exported or refused by name (secondary
+  // and the sphere families were skipped silently: exit 0 with edge only).
+  for (const auto& name : fams) {
+    const Family* f = find_family(name);
+    if (f->kind != ra::Kind::triangle)
+      throw ra::InputError("audit: --export-cases: '" + name +
+                           "' is a sphere family; the cases CSV holds rays and triangles only");
+    if (f->secondary)
+      throw ra::InputError("audit: --export-cases: 'secondary' has no fixed cases (its rays start at each method's own "
+                           "hit point); audit it with --families secondary");
+  }
+  if (fams.empty())
+    for (const Family& f : families())
+      if (f.kind == ra::Kind::triangle && !f.secondary) fams.push_back(f.name);
+  IdFilter ids(a.ids);
+  CasesStamp stamp{RAYAUDIT_VERSION, a.seed, a.rays, precision_name(p), {}};
+  for (const Family& f : families())  // the families' order, as the rows
+    if (std::find(fams.begin(), fams.end(), f.name) != fams.end()) stamp.families.push_back(f.name);
+  if (!ids.all()) {
+    // A first pass: every id must name a case (nothing written otherwise).
+    for_each_export_row(fams, p, a.seed, a.rays, [&](const ra::audit::ExportRow& r) { ids.take(r.id); });
+    ids.check("the export (--families " + join(stamp.families) + ", --seed " + std::to_string(a.seed) + ", --rays " +
+              std::to_string(a.rays) + ")");
+  }
   long long rows = 0;
   ra::write_atomically(a.export_cases, [&](const std::filesystem::path& tmp) {
     std::ofstream out(tmp, std::ios::binary);
-    out << ra::audit::cases_csv_header();
-    rows = for_each_export_row(fams, p, a.seed, a.rays,
-                               [&](const ra::audit::ExportRow& r) { out << ra::audit::cases_csv_row(r, numbers); });
+    out << stamp_line(stamp) << ra::audit::cases_csv_header();
+    for_each_export_row(fams, p, a.seed, a.rays, [&](const ra::audit::ExportRow& r) {
+      if (ids.take(r.id)) out << ra::audit::cases_csv_row(r, numbers), ++rows;
+    });
     out.close();
     if (!out) throw ra::InputError(ra::located(a.export_cases, 0, std::string("cannot write: ") + std::strerror(errno)));
   });
@@ -356,7 +468,22 @@ void export_cases(const Args& a) {
 
 // ------------------------------------------------------------ audit ---
 void audit(const Args& a) {
-  ra::OutputBatch outputs({a.json, a.csv});
+  ra::OutputBatch outputs({a.json, a.csv, a.junit});
+  if (!a.ids.empty()) throw ra::InputError("audit: --ids chooses cases of --cases or --export-cases");
+  if (!a.shard.empty() && (!a.baseline.empty() || !a.junit.empty()))
+    throw ra::InputError(std::string("audit: ") + (a.baseline.empty() ? "--junit" : "--baseline") +
+                         " judges a whole run, not a shard's partial counts: merge the shards (audit merge), then "
+                         "`rayaudit audit diff BASE.json MERGED.json`");
+  std::optional<nlohmann::json> base;
+  if (!a.baseline.empty()) {
+    base = ra::baseline::read_audit_json(a.baseline);
+    // Checked before the run: a mismatch found after an hour would waste it.
+    try {
+      ra::baseline::check_plan(*base, a.seed, a.rays);
+    } catch (const ra::baseline::Mismatch& e) {
+      throw ra::InputError(a.baseline + ": cannot be this run's baseline: " + e.what());
+    }
+  }
   // Whole tracers (--tracers): named before anything runs (an unknown name
   // lists the known ones); graded after the kernels, into the same JSON.
   std::vector<ra::tracers::Subject> tracer_subjects;
@@ -425,9 +552,15 @@ void audit(const Args& a) {
     std::fputs(tr.summary_table().c_str(), stdout);
     out["tracers"] = tr.to_json();
   }
+  // The failing families' case ids and replay commands: for a few subjects
+  // (a user's --methods), not the whole registry's documented failures.
+  ra::baseline::GateResult g;
+  if (!opt.shard)
+    g = ra::baseline::gate(out, base, {.baseline_name = a.baseline, .junit = a.junit, .failure_lines = rep.subjects.size() <= 4});
   if (!a.json.empty()) ra::write_text_atomically(a.json, out.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
+  if (g.rose) throw ra::CheckFailed("audit: worse than the baseline " + a.baseline + " (the rows marked ROSE)");
 }
 
 // ------------------------------------------------------------ merge ---
@@ -611,6 +744,14 @@ void setup(CLI::App& app) {
                     ->excludes(cases)
                     ->excludes(exp);
   (void)shard;
+  cmd->add_option("--ids", a->ids,
+                  "With --cases or --export-cases: only these case ids (or FAMILY:SWEEP:PROBE, every triangle of "
+                  "that ray), as a failing family names them")
+      ->check(ra::cli::non_empty_list());
+  cmd->add_option("--baseline", a->baseline,
+                  "Compare with this earlier audit's --json (same version, seed, --rays, families): exit 1 if any "
+                  "wrong count, leaks, double hits, NaN answers or t error rose");
+  cmd->add_option("--junit", a->junit, "Write JUnit XML: one test case per method x precision x family");
   auto* merge_cmd = cmd->add_subcommand(
       "merge", "Combine the --json outputs of every shard of one audit into what the unsharded run writes");
   merge_cmd->add_option("shards", a->merge_inputs, "The shards' JSON files (audit --shard K/N --json)")
@@ -618,8 +759,12 @@ void setup(CLI::App& app) {
   merge_cmd->add_option("--json", a->json, "Write the merged JSON here")->required();
   merge_cmd->add_option("--csv", a->csv, "Write the merged per-cell CSV here");
   merge_cmd->callback([a] { merge(*a); });
-  cmd->callback([a, merge_cmd, cmd] {
-    if (merge_cmd->parsed()) return;
+  cmd->callback([a, cmd] {
+    if (!cmd->get_subcommands().empty()) return;  // merge, diff: their own callbacks
+    if (!a->cases.empty() && a->grade.empty() && (!a->baseline.empty() || !a->junit.empty()))
+      throw ra::InputError("audit: --baseline and --junit judge an audit of families or --grade, not --cases");
+    if (!a->export_cases.empty() && (!a->baseline.empty() || !a->junit.empty()))
+      throw ra::InputError("audit: --export-cases writes only the cases CSV: drop --baseline/--junit");
     a->precision_given = cmd->count("--precision") > 0;
     // Given cases are not generated: the generator's options would be ignored.
     if (!a->cases.empty())

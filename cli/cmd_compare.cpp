@@ -16,6 +16,7 @@
 #include <iostream>
 #include <map>
 
+#include "baseline/junit.h"
 #include "io/atomic_file.h"
 #include "command.h"
 #include "errors.h"
@@ -41,7 +42,7 @@ namespace {
 constexpr int kSkipped = 77;
 
 struct Args {
-  std::string scene, json_out, diff_out, ours_out, pov_out, tolerance, out_dir, image;
+  std::string scene, json_out, diff_out, ours_out, pov_out, tolerance, out_dir, image, junit;
   int bits = 8, width = 0, height = 0, threads = 0, random = 0;
   std::uint64_t seed = 1;
   bool keep = false, skip_inexpressible = false, explain = false, accept_explained = false;
@@ -88,6 +89,8 @@ void run_random(const Args& a) {
     if (ec || !fs::is_directory(a.out_dir)) throw ra::InputError(a.out_dir + ": cannot create the --out directory");
     ra::check_output_path(fs::path(a.out_dir) / "unexplained.json");
   }
+  ra::OutputBatch outputs({a.junit});
+  ra::junit::Suite junit{"rayaudit compare --random", {}};  // --junit: one test case per scene
   int differed = 0, unexplained_scenes = 0;
   std::map<std::string, int> causes;
   nlohmann::json report = nlohmann::json::array();
@@ -101,12 +104,14 @@ void run_random(const Args& a) {
       if (!p.cause.empty()) ++causes[cause_name(p.cause)];
     if (r.differing == 0) {
       std::cout << name << ": identical" << std::endl;
+      junit.cases.push_back({"compare", name, ra::junit::Case::Status::pass, "", "", 0});
       continue;
     }
     ++differed;
     if (r.unexplained() == 0) {
       std::cout << name << ": " << r.differing << " pixels differ, all explained (" << cause_counts(r.pixels) << ")"
                 << std::endl;
+      junit.cases.push_back({"compare", name, ra::junit::Case::Status::pass, "", "", 0});
       continue;
     }
     ++unexplained_scenes;
@@ -129,6 +134,11 @@ void run_random(const Args& a) {
       entry["original_scene"] = (fs::path(a.out_dir) / (name + ".original.json")).string();
     }
     std::cout << std::endl;
+    junit.cases.push_back({"compare", name, ra::junit::Case::Status::fail,
+                           std::to_string(r.unexplained()) + " of " + std::to_string(r.differing) +
+                               " differing pixels have no known cause (largest at (" + std::to_string(first->x) + ", " +
+                               std::to_string(first->y) + "), " + std::to_string(first->levels) + " levels)",
+                           entry.dump(1), 0});
     report.push_back(entry);
   }
   std::cout << "random scenes: " << a.random << " (seed " << a.seed << "), " << differed << " differed, "
@@ -137,6 +147,8 @@ void run_random(const Args& a) {
   for (const auto& [name, k] : causes) counts += (counts.empty() ? "" : ", ") + name + " x" + std::to_string(k);
   if (!counts.empty()) std::cout << "explained pixels by cause: " << counts << "\n";
   if (!a.out_dir.empty()) ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (!a.junit.empty()) ra::junit::write(a.junit, {junit});
+  outputs.commit();
   if (unexplained_scenes > 0)
     throw ra::CheckFailed(std::to_string(unexplained_scenes) + " random scenes have pixels no known cause explains" +
                           (a.out_dir.empty() ? std::string(" (give --out DIR for minimal scenes)")
@@ -193,7 +205,7 @@ void run(const Args& a) {
     if (!out->empty() && ext != ".png" && ext != ".exr")
       throw ra::InputError(*out + ": unsupported output format (use .png or .exr)");
   }
-  ra::OutputBatch outputs({a.json_out, a.diff_out, a.ours_out, a.pov_out});
+  ra::OutputBatch outputs({a.json_out, a.diff_out, a.ours_out, a.pov_out, a.junit});
   // Image outputs' formats with the other destination checks, before both
   // renders (x.jpg failed after them: minutes of POV-Ray lost).
   for (auto [flag, path] : {std::pair{"--diff", &a.diff_out}, {"--ours", &a.ours_out}, {"--pov", &a.pov_out}}) {
@@ -299,6 +311,21 @@ void run(const Args& a) {
     }
     ra::write_text_atomically(a.json_out, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
+  if (!a.junit.empty()) {
+    // One test case for the scene, judged as the exit code below judges it.
+    int unexplained = 0;
+    for (const auto& e : explained) unexplained += e.cause.empty();
+    const bool pass = a.accept_explained ? unexplained == 0 : v.pass;
+    std::string lines;
+    for (const auto& line : v.lines) lines += line + "\n";
+    const std::string message =
+        a.accept_explained ? std::to_string(unexplained) + " of " + std::to_string(c.differences.size()) +
+                                 " differing pixels have no known cause"
+                           : "our render differs from POV-Ray's beyond the tolerance";
+    ra::junit::write(a.junit, {{"rayaudit compare", {{"compare", a.scene, pass ? ra::junit::Case::Status::pass
+                                                                                 : ra::junit::Case::Status::fail,
+                                                       pass ? "" : message, ra::summary(c) + lines, 0}}}});
+  }
   outputs.commit();  // also when the check fails: the diff and JSON say why
   if (a.accept_explained) {
     // Every differing pixel must have a known cause (the corpus sweep).
@@ -344,6 +371,7 @@ void setup(CLI::App& app) {
                   "Judge this PNG (another renderer's image of SCENE: the scene's size, --bits, RGB, linear values) "
                   "against POV-Ray's render instead of ours");
   cmd->add_option("--json", args->json_out, "Write the statistics as JSON");
+  cmd->add_option("--junit", args->junit, "Write JUnit XML: one test case per scene, failing as the exit code does");
   cmd->add_option("--diff", args->diff_out, "Write a false-colour difference image (.png)");
   cmd->add_option("--ours", args->ours_out, "Write our render (.png)");
   cmd->add_option("--pov", args->pov_out, "Write POV-Ray's render (.png)");

@@ -14,6 +14,7 @@
 #include "io/file_identity.h"
 #include "command.h"
 #include "errors.h"
+#include "baseline/junit.h"
 #include "images/golden.h"
 #include "images/golden_project.h"
 #include "images/their_image.h"
@@ -23,7 +24,7 @@ namespace {
 struct Args {
   std::vector<std::string> scenes;
   std::string root;  // empty: found from the current directory
-  std::string diff_dir, json, image;
+  std::string diff_dir, json, image, junit;
   bool skip_unavailable = false;
 };
 
@@ -133,8 +134,9 @@ void check(Args a) {
       }
     }
   } made;
-  ra::OutputBatch outputs({a.json});
+  ra::OutputBatch outputs({a.json, a.junit});
   const ra::GoldenSet set(a.root);
+  ra::junit::Suite junit{"rayaudit golden check", {}};  // --junit: one test case per scene
   const std::filesystem::path diff_dir =
       a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden" : std::filesystem::path(a.diff_dir);
   int failed = 0, skipped = 0;
@@ -209,6 +211,7 @@ void check(Args a) {
                               ", which is not there (ci/main.sh makes the teapot; ci/fetch-corpus.sh the corpus)";
       std::cout << "skip " << n << ": " << why << "\n";
       rows.push_back({{"name", n}, {"status", "skip"}, {"message", why}, {"scene", "scenes/" + n + ".json"}});
+      junit.cases.push_back({"golden", n, ra::junit::Case::Status::skip, why, "", 0});
       ++skipped;
       continue;
     }
@@ -221,6 +224,8 @@ void check(Args a) {
     row["status"] = r.pass ? "ok" : "fail";
     row["message"] = r.message;
     rows.push_back(row);
+    junit.cases.push_back({"golden", n, r.pass ? ra::junit::Case::Status::pass : ra::junit::Case::Status::fail,
+                           r.message, r.message, 0});
     failed += !r.pass;
   }
   // Written whatever the verdict: a failed check is what the report must show.
@@ -234,6 +239,7 @@ void check(Args a) {
                               {"scenes", rows}};
     ra::write_text_atomically(a.json, j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   }
+  if (!a.junit.empty()) ra::junit::write(a.junit, {junit});
   outputs.commit();  // the JSON and the diff images
   if (failed)
     throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
@@ -279,6 +285,7 @@ void setup(CLI::App& app) {
       sub->add_option("--json", args->json,
                       "Write each scene's status (ok, fail, skip), message and comparison (compare --json's fields, "
                       "coordinates in scene pixels) as JSON");
+      sub->add_option("--junit", args->junit, "Write JUnit XML: one test case per scene, failing with its message");
     }
     sub->callback([args, fn] { fn(*args); });
   };

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -26,8 +27,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 struct Args {
-  std::string audit, crack_maps, golden, stages, out;
+  std::string audit, crack_maps, golden, stages, out, timings;
   std::vector<std::string> compare, bench;
+  std::vector<std::string> audits;  // every --audit; `audit` is the first
 };
 
 // Debian's matplotlib is installed for the system interpreter only.
@@ -101,8 +103,8 @@ const json& need(const fs::path& f, const json& j, const std::string& where, con
   return v;
 }
 
-void check_audit(const fs::path& f) {
-  const json j = read_json(f);
+json check_audit(const fs::path& f) {
+  json j = read_json(f);
   if (!j.is_object()) throw ra::InputError(f.string() + ": not an audit JSON (rayaudit audit --json): not an object");
   if (j.contains("cases") && !j.contains("subjects"))
     throw ra::InputError(f.string() + ": an `audit --cases` output; the report needs the families' audit (rayaudit audit --json)");
@@ -132,6 +134,58 @@ void check_audit(const fs::path& f) {
       if (!(v.get<double>() >= 0))
         throw ra::InputError(f.string() + ": " + at + ".stats." + k + ": " + v.dump() + " is negative");
     }
+  }
+  return j;
+}
+
+// Several audits on one page (the main run, users' graded or API runs):
+// the same seed and rays, so their figures are of the same cases, and no
+// subject twice.
+void check_audits(const std::vector<std::string>& files) {
+  json first;
+  std::map<std::string, std::string> owner;
+  for (const auto& f : files) {
+    const json j = check_audit(f);
+    if (first.is_null()) first = j;
+    else
+      for (const char* k : {"seed", "rays_per_family"})
+        if (j[k] != first[k])
+          throw ra::InputError(f + ": " + k + " " + j[k].dump() + ", but " + files[0] + " has " + first[k].dump() +
+                               " (--audit files must be runs of the same seed and rays; export the cases with "
+                               "--seed and --rays as the main run)");
+    for (const auto& s : j["subjects"]) {
+      const std::string name = s["name"].get<std::string>();
+      if (owner.count(name) && owner[name] != f)
+        throw ra::InputError(f + ": subject '" + name + "' is also in " + owner[name] + " (rename the answers file)");
+      owner[name] = f;
+    }
+  }
+}
+
+// subject,ns_per_test (validation/baseline/timing.h): users' kernels timed
+// as the kernel/ rows are.
+void check_timings(const fs::path& f) {
+  std::istringstream in(read_file(f));
+  std::string line;
+  int n = 0;
+  for (bool header = true; ra::read_text_line(in, line);) {
+    ++n;
+    if (line.empty() || line[0] == '#') continue;
+    if (header) {
+      if (line != "subject,ns_per_test") throw ra::InputError(ra::located(f.string(), n, "expected the header subject,ns_per_test"));
+      header = false;
+      continue;
+    }
+    const auto comma = line.rfind(',');
+    const std::string subject = comma == std::string::npos ? "" : line.substr(0, comma);
+    const auto slash = subject.rfind('/');
+    if (slash == std::string::npos || slash == 0 || slash + 1 == subject.size())
+      throw ra::InputError(ra::located(f.string(), n, "expected METHOD/PRECISION,NS (e.g. mine/float,4.2)"));
+    char* end = nullptr;
+    const std::string num = line.substr(comma + 1);
+    const double v = std::strtod(num.c_str(), &end);
+    if (num.empty() || num.find_first_not_of("0123456789.eE+-") != std::string::npos || *end || !std::isfinite(v) || v <= 0)
+      throw ra::InputError(ra::located(f.string(), n, "ns_per_test '" + num + "' is not a positive number"));
   }
 }
 
@@ -278,11 +332,12 @@ void run(const Args& a) {
     throw ra::InputError(a.out + ": its parent directory does not exist");
   if (!fs::exists(dir) && ::access(fs::absolute(dir).parent_path().c_str(), W_OK) != 0)
     throw ra::InputError(ra::located(a.out, 0, std::string("cannot create the directory: ") + std::strerror(errno)));
-  // Either alone makes a page: the audit's correctness, or (a
+  // Either alone makes a page: the audits' correctness, or (a
   // performance-only report) the benchmarks'.
-  if (a.audit.empty() && a.bench.empty())
+  if (a.audits.empty() && a.bench.empty())
     throw ra::InputError("rayaudit report: needs --audit FILE, --bench FILE, or both");
-  if (!a.audit.empty()) check_audit(a.audit);
+  if (!a.audits.empty()) check_audits(a.audits);
+  if (!a.timings.empty()) check_timings(a.timings);
   for (const auto& b : a.bench) check_bench(b);
   for (const auto& d : a.compare) check_compare_dir(d);
   if (!a.crack_maps.empty()) check_crack_maps(a.crack_maps);
@@ -310,7 +365,11 @@ void run(const Args& a) {
   for (const auto& d : a.compare) compare.push_back(absolute(d));
   json benches = json::array();
   for (const auto& b : a.bench) benches.push_back(absolute(b));
+  json audits = json::array(), audits_hex = json::array();
+  for (const auto& f : a.audits) audits.push_back(absolute(f)), audits_hex.push_back(hex_bytes(absolute(f)));
   json ctx = {{"audit", a.audit.empty() ? json(nullptr) : json(absolute(a.audit))},
+                    {"audits", audits},
+                    {"timings", a.timings.empty() ? json(nullptr) : json(absolute(a.timings))},
                     {"bench", benches},
                     {"compare", compare},
                     {"crack_maps", a.crack_maps.empty() ? json(nullptr) : json(absolute(a.crack_maps))},
@@ -339,6 +398,8 @@ void run(const Args& a) {
   json bench_hex = json::array();
   for (const auto& b : a.bench) bench_hex.push_back(hex_bytes(absolute(b)));
   fs_paths["bench"] = bench_hex;
+  fs_paths["audits"] = audits_hex;
+  if (!a.timings.empty()) fs_paths["timings"] = hex_bytes(absolute(a.timings));
   ctx["fs_paths"] = fs_paths;
   std::ofstream(tmp / "context.json") << ctx.dump(1, ' ', false, nlohmann::json::error_handler_t::replace);
   const int rc = run_script(tmp / "context.json");
@@ -374,7 +435,12 @@ void setup(CLI::App& app) {
   auto* cmd = app.add_subcommand("report",
                                  "One self-contained HTML page (and report.json) from earlier outputs: speed against "
                                  "accuracy, stability, crack maps, optimisations, peers, images");
-  cmd->add_option("--audit", a->audit, "rayaudit audit --json output (without it: a performance-only report)");
+  cmd->add_option("--audit", a->audits,
+                  "rayaudit audit --json output (repeat for users' graded (--grade) or API runs of the same seed "
+                  "and rays, drawn beside the registry; without it: a performance-only report)");
+  cmd->add_option("--timings", a->timings,
+                  "CSV subject,ns_per_test timing users' subjects as the kernel/ rows are (validation/baseline/"
+                  "timing.h), for the speed chart");
   cmd->add_option("--bench", a->bench,
                   "rayaudit bench --json output (repeatable: several runs are combined, each row the median of "
                   "their medians, runs whose calibration was slow left out and named)");
@@ -385,7 +451,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--golden", a->golden, "rayaudit golden check --json output");
   cmd->add_option("--stages", a->stages, "Stage timings (STAGE<TAB>SECONDS lines, as ci/main.sh writes)");
   cmd->add_option("-o,--out", a->out, "Directory for index.html and report.json")->required();
-  cmd->callback([a] { run(*a); });
+  cmd->callback([a] {
+    if (!a->audits.empty()) a->audit = a->audits.front();
+    run(*a);
+  });
 }
 
 ra::cli::Registrar reg(90, setup);

@@ -17,7 +17,10 @@ EPSILON = 0.000001  # the paper's
 
 def read_cases(path):
     with open(path) as f:
-        header = f.readline().strip().split(",")
+        header = f.readline()
+        while header.startswith("#"):  # the export's stamp: version, seed, rays, precision, families
+            header = f.readline()
+        header = header.strip().split(",")
         col = {name: i for i, name in enumerate(header)}
         ids, rows = [], []
         for line in f:

@@ -105,6 +105,17 @@ void Stats::merge(const Stats& o) {
   max_rel = std::max(max_rel, o.max_rel);
   for (int i = 0; i < kUlpBins; ++i) add(ulp_hist[i], o.ulp_hist[i]);
   for (int i = 0; i < kRelBins; ++i) add(rel_hist[i], o.rel_hist[i]);
+  add(back_hits, o.back_hits), add(back_false_misses, o.back_false_misses);
+  for (std::uint64_t e : o.examples) note_example(e);
+}
+
+// Keeps the kExamples lowest: the same set in any merge order.
+void Stats::note_example(std::uint64_t probe) {
+  const auto at = std::lower_bound(examples.begin(), examples.end(), probe);
+  if (at != examples.end() && *at == probe) return;
+  if (examples.size() >= kExamples && at == examples.end()) return;
+  examples.insert(at, probe);
+  if (examples.size() > kExamples) examples.pop_back();
 }
 
 std::uint64_t Stats::median_ulps() const {
@@ -143,7 +154,9 @@ nlohmann::json Stats::to_json() const {
                       {"t_ulps_median", median_ulps()},
                       {"t_ulps_max", max_ulps},
                       {"t_rel_median", median_rel()},
-                      {"t_rel_max", max_rel}};
+                      {"t_rel_max", max_rel},
+                      {"back_hits", back_hits},
+                      {"back_false_misses", back_false_misses}};
   return j;
 }
 
@@ -167,7 +180,7 @@ void check_merged_stats(const nlohmann::json& j, const nlohmann::json& h, const 
       "tests", "wrong", "wrong_pct", "true_hits", "false_hits", "true_misses", "false_misses", "boundary_hits",
       "boundary_misses", "coplanar_hits", "coplanar_misses", "degenerate_hits", "degenerate_misses", "nan_inf",
       "wrong_t", "groups", "leaks", "double_hits", "spawned", "self_hits", "t_samples", "t_ulps_median",
-      "t_ulps_max", "t_rel_median", "t_rel_max"};
+      "t_ulps_max", "t_rel_median", "t_rel_max", "back_hits", "back_false_misses"};
   for (const auto& [key, value] : j.items())
     if (!stats_keys.count(key)) throw std::runtime_error("stats: '" + key + "': unknown key");
   for (const auto& [key, value] : h.items())
@@ -189,6 +202,8 @@ void check_merged_stats(const nlohmann::json& j, const nlohmann::json& h, const 
   too_many("leaks", s.leaks, "groups", s.groups);
   too_many("double_hits", s.double_hits, "groups", s.groups);
   too_many("self_hits", s.self_hits, "spawned", s.spawned);
+  too_many("back_false_misses", s.back_false_misses, "back_hits", s.back_hits);
+  too_many("back_hits", s.back_hits, "true_hits + false_misses", s.true_hits + s.false_misses);
   if (j.contains("wrong") && (!j["wrong"].is_number_unsigned() || j["wrong"].get<std::uint64_t>() != s.wrong()))
     throw std::runtime_error("stats: 'wrong' is not false_hits + false_misses + wrong_t (" + std::to_string(s.wrong()) +
                              ")");
@@ -211,6 +226,9 @@ Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
   s.groups = u("groups"), s.leaks = u("leaks"), s.double_hits = u("double_hits");
   s.spawned = u("spawned"), s.self_hits = u("self_hits");
   s.t_samples = u("t_samples"), s.max_ulps = u("t_ulps_max");
+  // Written since the one-sided hint; absent from older files.
+  if (j.contains("back_hits")) s.back_hits = u("back_hits");
+  if (j.contains("back_false_misses")) s.back_false_misses = u("back_false_misses");
   if (!j.contains("t_rel_max") || !j["t_rel_max"].is_number())
     throw std::runtime_error("stats: 't_rel_max' is missing or not a number");
   s.max_rel = j["t_rel_max"].get<double>();
@@ -342,32 +360,58 @@ void book_group(Stats& st, int count, const GroupHits& g, int cross, bool proper
   }
 }
 
+// Books which side a hit case is met from (see Stats::back_hits).
+void book_side(Stats& st, const oracle::Answer& a, bool hit, const Tri& t, const Rayd& r) {
+  if (a.verdict != oracle::Verdict::hit || !(dot(cross(t.b - t.a, t.c - t.a), r.d) > 0)) return;
+  ++st.back_hits;
+  st.back_false_misses += !hit;
+}
+
+// Probe number `i` of a chunk in the family's sweep value: probes are
+// numbered first, first + stride, ... (stride = the shard count when a
+// chunk is dealt by probe).
+struct ProbeNumbers {
+  std::uint64_t first = 0, stride = 1;
+  std::uint64_t operator()(std::size_t i) const { return first + stride * i; }
+};
+
 template <class T>
 void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
                  const std::vector<oracle::Answer>& ans, const std::vector<int>& cross,
-                 const std::vector<char>& proper, Stats& st) {
+                 const std::vector<char>& proper, Stats& st, ProbeNumbers number) {
   const auto& f = fn<T>(s);
   std::size_t pair = 0;  // index into ans, see judge()
   for (std::size_t pi = 0; pi < b.probes.size(); ++pi) {
     const Probe& p = b.probes[pi];
     const Ray<T> r = cr<T>(p.ray);
+    const std::uint64_t bad = st.bad();
     GroupHits g;
     for (int k = p.first; k < p.first + p.count; ++k, ++pair) {
       const Tri& t = b.tris[std::size_t(k)];
       const auto h = f(r, cv<T>(t.a), cv<T>(t.b), cv<T>(t.c));
       g.add(h.has_value(), ans[pair]);
       book<T>(st, ans[pair], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
+      book_side(st, ans[pair], h.has_value(), t, p.ray);
     }
     book_group(st, p.count, g, cross[pi], proper[pi]);
+    if (st.bad() != bad) st.note_example(number(pi));
   }
 }
 
 // Secondary rays from the subject's own hit point: a mirror reflection and a
 // shadow ray back toward the primary ray's origin (a light at the camera).
 template <class T>
-void eval_secondary(const TriangleSubject& s, SelfIntersection strategy, const TriangleBatch& b, Stats& st) {
+void eval_secondary(const TriangleSubject& s, SelfIntersection strategy, const TriangleBatch& b, Stats& st,
+                    ProbeNumbers number) {
   const auto& f = fn<T>(s);
-  for (const Probe& p : b.probes) {
+  for (std::size_t pi = 0; pi < b.probes.size(); ++pi) {
+    const Probe& p = b.probes[pi];
+    const std::uint64_t bad = st.bad();
+    struct Note {  // at every exit of this probe's body
+      Stats& st;
+      std::uint64_t bad, n;
+      ~Note() { if (st.bad() != bad) st.note_example(n); }
+    } note{st, bad, number(pi)};
     const Tri& tri = b.tris[std::size_t(p.first)];
     const Vec3<T> A = cv<T>(tri.a), B = cv<T>(tri.b), C = cv<T>(tri.c);
     const Ray<T> primary = cr<T>(p.ray);
@@ -394,11 +438,13 @@ void eval_secondary(const TriangleSubject& s, SelfIntersection strategy, const T
 
 template <class T>
 void eval_spheres(const SphereSubject& s, const std::vector<SphereCase>& cs,
-                  const std::vector<oracle::Answer>& ans, Stats& st) {
+                  const std::vector<oracle::Answer>& ans, Stats& st, ProbeNumbers number) {
   const auto& f = fn<T>(s);
   for (std::size_t i = 0; i < cs.size(); ++i) {
+    const std::uint64_t bad = st.bad();
     const auto h = f(cr<T>(cs[i].ray), cv<T>(cs[i].center), T(cs[i].radius));
     book<T>(st, ans[i], h.has_value(), h && finite_hit(*h), h ? h->t : T(0));
+    if (st.bad() != bad) st.note_example(number(i));
   }
 }
 
@@ -520,6 +566,7 @@ void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const
   for (int k = 0; k < count; ++k) {
     const GivenAnswer& g = given[k];
     group.add(g.hit, ans[std::size_t(k)]);
+    book_side(st, ans[std::size_t(k)], g.hit, in[std::size_t(k)], r);
     if (p == Precision::f32)
       book<float>(st, ans[std::size_t(k)], g.hit, finite_hit(TriangleHit<float>{float(g.t), float(g.u), float(g.v)}),
                   float(g.t));
@@ -645,6 +692,12 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
       } const t{ch.sweep->family, ch.sweep->sweep, ch.count};
       const std::size_t fi = ch.sweep->fam_index;
       const std::uint64_t stream = stream_seed(opt.seed, t.family->name, t.sweep, ch.index);
+      // The probes' numbers in the sweep value (keep_dealt keeps j % n == k - 1).
+      ProbeNumbers number{ch.index * kChunk, 1};
+      if (ch.sweep->by_probe) {
+        number.stride = shard.n;
+        number.first += (shard.k - 1 + shard.n - number.first % shard.n) % shard.n;
+      }
       std::vector<std::pair<std::size_t, Stats>> results;
       for (Precision p : {Precision::f32, Precision::f64}) {
         if (t.family->kind == Kind::triangle) {
@@ -671,11 +724,11 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
             Stats st;
             if (t.family->secondary) {
               const auto strategy = SelfIntersection(secondary_strategy(t.sweep));
-              p == Precision::f32 ? eval_secondary<float>(tris[si], strategy, b, st)
-                                  : eval_secondary<double>(tris[si], strategy, b, st);
+              p == Precision::f32 ? eval_secondary<float>(tris[si], strategy, b, st, number)
+                                  : eval_secondary<double>(tris[si], strategy, b, st, number);
             } else {
-              p == Precision::f32 ? eval_probes<float>(tris[si], b, ans, cross, proper, st)
-                                  : eval_probes<double>(tris[si], b, ans, cross, proper, st);
+              p == Precision::f32 ? eval_probes<float>(tris[si], b, ans, cross, proper, st, number)
+                                  : eval_probes<double>(tris[si], b, ans, cross, proper, st, number);
             }
             results.emplace_back(cell_index(si, fi, t.sweep), st);
           }
@@ -691,8 +744,8 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           for (std::size_t si = 0; si < spheres.size(); ++si) {
             if (spheres[si].precision != p) continue;
             Stats st;
-            p == Precision::f32 ? eval_spheres<float>(spheres[si], cs, ans, st)
-                                : eval_spheres<double>(spheres[si], cs, ans, st);
+            p == Precision::f32 ? eval_spheres<float>(spheres[si], cs, ans, st, number)
+                                : eval_spheres<double>(spheres[si], cs, ans, st, number);
             results.emplace_back(cell_index(tris.size() + si, fi, t.sweep), st);
           }
         }
@@ -748,6 +801,13 @@ nlohmann::json Report::to_json() const {
                   {"param", f ? f->param : ""},
                   {"sweep", c.sweep_label},
                   {"stats", c.stats.to_json()}});
+    if (!c.example_ids.empty()) {
+      cs.back()["examples"] = c.example_ids;
+    } else if (!c.stats.examples.empty()) {
+      nlohmann::json ids = nlohmann::json::array();
+      for (std::uint64_t e : c.stats.examples) ids.push_back(c.family + ":" + c.sweep_label + ":" + std::to_string(e));
+      cs.back()["examples"] = ids;
+    }
     if (shard) cs.back()["histograms"] = c.stats.histograms_json();
   }
   nlohmann::json out = {{"seed", seed},
@@ -810,6 +870,21 @@ Report Report::from_json(const nlohmann::json& j) {
       cell.stats = Stats::from_json(need(c, "stats"), c.contains("histograms") ? c["histograms"] : nlohmann::json());
     } catch (const std::runtime_error& e) {
       throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "]." + e.what());
+    }
+    // Failing case ids: FAMILY:SWEEP:PROBE back to probe numbers (so shards
+    // merge them), any other id kept as written.
+    if (c.contains("examples")) {
+      if (!c["examples"].is_array()) throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "].examples: not an array");
+      const std::string prefix = cell.family + ":" + cell.sweep_label + ":";
+      for (const auto& e : c["examples"]) {
+        if (!e.is_string()) throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "].examples: not strings");
+        const std::string id = e.get<std::string>();
+        const std::string n = id.rfind(prefix, 0) == 0 ? id.substr(prefix.size()) : "";
+        if (!n.empty() && n.size() < 20 && n.find_first_not_of("0123456789") == std::string::npos)
+          cell.stats.note_example(std::stoull(n));
+        else if (cell.example_ids.size() < Stats::kExamples)
+          cell.example_ids.push_back(id);
+      }
     }
     r.cells.push_back(std::move(cell));
   }

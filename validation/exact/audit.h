@@ -107,6 +107,18 @@ struct Stats {
   double max_rel = 0;
   std::array<std::uint64_t, kUlpBins> ulp_hist{};
   std::array<std::uint64_t, kRelBins> rel_hist{};
+  // Hit cases (exact verdict hit) whose ray meets the triangle from behind,
+  // d . ((b-a) x (c-a)) > 0, and how many of them the subject missed: all
+  // of them missed while the front is hit is a one-sided (culling) subject.
+  std::uint64_t back_hits = 0, back_false_misses = 0;
+  // The lowest probe numbers (within the family's sweep value, as the
+  // export numbers them) with a wrong answer, leak, double hit or NaN: at
+  // most kExamples, the same whatever the threads or shards.
+  static constexpr std::size_t kExamples = 3;
+  std::vector<std::uint64_t> examples;
+  // wrong + NaN + leaks + double hits: what makes a probe an example.
+  std::uint64_t bad() const { return wrong() + nan_inf + leaks + double_hits; }
+  void note_example(std::uint64_t probe);
 
   void merge(const Stats& o);
   std::uint64_t wrong() const { return false_hits + false_misses + wrong_t; }
@@ -151,6 +163,9 @@ struct Cell {
   int sweep;
   std::string sweep_label;
   Stats stats;
+  // Failing case ids when they are not FAMILY:SWEEP:PROBE of stats.examples
+  // (graded answers name their own); to_json writes one or the other.
+  std::vector<std::string> example_ids;
 };
 
 struct Report {

@@ -94,7 +94,10 @@ std::vector<std::string> read_csv_header(std::istream& in, const std::string& pa
   while (header.empty() && read_text_line(in, line)) {
     ++lineno;
     check_header_encoding(path, lineno, line);
-    if (line.find_first_not_of(" \t") != std::string::npos) header = split_fields(line);
+    // Lines starting with '#' before the header are comments (an export's
+    // stamp, exact/../baseline/stamp.h).
+    const auto first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line[first] != '#') header = split_fields(line);
   }
   check_unique_columns(path, lineno, header);
   return header;

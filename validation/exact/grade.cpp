@@ -101,7 +101,7 @@ Report grade_answers(const std::string& answers_csv, const std::string& cases_cs
 
   // The ray being read: its rows (one per triangle) until the key changes.
   struct Pending {
-    std::string key, family, sweep;
+    std::string key, family, sweep, first_id;
     Rayd ray;
     std::vector<Tri> tris;
     std::vector<GivenAnswer> given;
@@ -115,8 +115,13 @@ Report grade_answers(const std::string& answers_csv, const std::string& cases_cs
       if (f) w = int(std::find(f->sweep.begin(), f->sweep.end(), cur.sweep) - f->sweep.begin());
       rep.cells.push_back({0, cur.family, w, cur.sweep, {}});
     }
-    grade_probe(rep.cells[it->second].stats, p, cur.ray, cur.tris.data(), cur.given.data(),
-                int(cur.tris.size()), cur.family == "closed-mesh");
+    Cell& cell = rep.cells[it->second];
+    const std::uint64_t bad = cell.stats.bad();
+    grade_probe(cell.stats, p, cur.ray, cur.tris.data(), cur.given.data(), int(cur.tris.size()),
+                cur.family == "closed-mesh");
+    // The first failing rays in file order, by the id --ids takes back.
+    if (cell.stats.bad() != bad && cell.example_ids.size() < Stats::kExamples)
+      cell.example_ids.push_back(cur.key.empty() ? cur.first_id : cur.key);
     cur.tris.clear(), cur.given.clear();
   };
   for_each_case(cases_csv, [&](const UserCase& c, long line) {
@@ -136,7 +141,7 @@ Report grade_answers(const std::string& answers_csv, const std::string& cases_cs
         throw InputError(located(cases_csv, line, "case '" + c.id + "' does not follow the other rows of its ray "
                                                   "(keep the export's order)"));
       cur.key = grouped ? key : std::string();
-      cur.family = family, cur.sweep = sweep, cur.ray = c.ray;
+      cur.family = family, cur.sweep = sweep, cur.ray = c.ray, cur.first_id = c.id;
     } else if (k != long(cur.tris.size()) || !(c.ray.o == cur.ray.o && c.ray.d == cur.ray.d)) {
       throw InputError(located(cases_csv, line, "case '" + c.id + "' does not follow the other rows of its ray "
                                                 "(keep the export's order and rays)"));

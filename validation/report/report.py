@@ -147,7 +147,11 @@ def sweep_number(label):
 
 
 class Methods:
-    """The registry as rayaudit reports it: colours, and which are the documents'."""
+    """The registry as rayaudit reports it: colours, and which are the documents'.
+    Subjects that are not the registry's (users' graded or API runs) get
+    colours of their own and the label "(yours)" in every chart and legend."""
+
+    USER_COLOURS = ["#e6007e", "#00a6a6", "#8c564b", "#6a3d9a", "#b15928", "#1f1f1f"]
 
     def __init__(self, methods):
         self.by_name = {m["name"]: m for m in methods}
@@ -159,13 +163,22 @@ class Methods:
             self.colour[n] = cmap(i % 10)
         for i, n in enumerate(sph):
             self.colour[n] = cmap((i + 4) % 10)
+        self.users = []
+
+    def add_user(self, name):
+        if name not in self.by_name and name not in self.users:
+            self.colour[name] = self.USER_COLOURS[len(self.users) % len(self.USER_COLOURS)]
+            self.users.append(name)
+
+    def is_user(self, name):
+        return name in self.users
 
     def is_document(self, name):
         m = self.by_name.get(name)
         return bool(m) and m["source"].startswith("seeds/")
 
     def label(self, name):
-        return name + (" (doc)" if self.is_document(name) else "")
+        return name + (" (doc)" if self.is_document(name) else "") + (" (yours)" if self.is_user(name) else "")
 
 
 def bench_rows(bench):
@@ -191,7 +204,7 @@ def parse_bench_name(name):
 # ---------------------------------------------------------------- section 1 --
 
 
-def speed_accuracy(audit, bench, methods):
+def speed_accuracy(audit, bench, methods, timings=None):
     rows = bench_rows(bench)
     ns = {}
     for name, b in rows.items():
@@ -209,7 +222,7 @@ def speed_accuracy(audit, bench, methods):
             "precision": s["precision"],
             "kind": s["kind"],
             "document_variant": methods.is_document(s["method"]),
-            "ns_per_test": ns.get((s["method"], s["precision"]), (None,))[0],
+            "ns_per_test": ns.get((s["method"], s["precision"]), ((timings or {}).get(s["name"]),))[0],
             "ns_spread": ns.get((s["method"], s["precision"]), (None, None))[1],
             "ns_flagged": ns.get((s["method"], s["precision"]), (None, None, ""))[2],
             "wrong_pct": t["wrong_pct"],
@@ -241,12 +254,17 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
         if sp:  # thin: min-max over repetitions and runs; thick: the quartiles
             ax.errorbar([x], [y], xerr=[[x - sp["min"]], [sp["max"] - x]], fmt="none", ecolor=c, lw=0.7, alpha=0.6)
             ax.errorbar([x], [y], xerr=[[x - sp["q1"]], [sp["q3"] - x]], fmt="none", ecolor=c, lw=2.2, alpha=0.8)
-        ax.scatter([x], [y], s=60, marker="*" if e.get("peer") else "o" if e["precision"] == "float" else "s",
-                   facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=3)
-        labels.append(ax.annotate(("doc: " if doc else "peer: " if e.get("peer") else "") + e["method"] + ("/f" if e["precision"] == "float" else "/d")
+        user = methods.is_user(e["method"])
+        ax.scatter([x], [y], s=140 if user else 60,
+                   marker="*" if user or e.get("peer") else "o" if e["precision"] == "float" else "s",
+                   facecolors="none" if doc else [c], edgecolors=[c], linewidths=1.8, zorder=4 if user else 3)
+        labels.append(ax.annotate(("doc: " if doc else "peer: " if e.get("peer") else "yours: " if user else "")
+                                  + e["method"] + ("/f" if e["precision"] == "float" else "/d")
                                   + (" (!)" if e.get("ns_flagged") else ""),
-                                  (x, y), textcoords="offset points", xytext=(4, 3), fontsize=6.5,
-                                  color=c, alpha=0.9))
+                                  (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7.5 if user else 6.5,
+                                  color=c, alpha=0.9, fontweight="bold" if user else "normal"))
+    for name in dict.fromkeys(e["method"] for e in entries if methods.is_user(e["method"])):
+        ax.scatter([], [], s=140, marker="*", color=methods.colour[name], label=methods.label(name))
     front = pareto(pts)
     if len(front) > 1:
         ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "k--", lw=1, alpha=0.6,
@@ -745,6 +763,7 @@ def machine(ctx, audit, bench, stages):
         "versions": versions,
         "seed": (audit or {}).get("seed"),
         "rays_per_family": (audit or {}).get("rays_per_family"),
+        "audit_inputs": (audit or {}).get("_inputs", []),
         "stages": stages,
     }
 
@@ -807,7 +826,12 @@ def perf_facts(rep):
                      f"{esc(STAMP[0])}): <b>{esc(f['subject'])}</b> at {fnum(f['ns_per_test'])} ns{spread}"
                      f" ({fnum(f['wrong_pct'])}% wrong){tie}" + (" <span class=\"warn\">flagged</span>"
                                                                  if f.get("ns_flagged") else ""))
-    if sa:
+    if len(sa) == 1:
+        # One subject is not "most right" of anything.
+        e = sa[0]
+        facts.append(f"One triangle subject: <b>{esc(e['subject'])}</b> "
+                     f"({fnum(e['wrong_pct'])}% wrong, {e['leaks']:,} leaks)")
+    elif sa:
         right = min(sa, key=lambda e: (e["leaks"] > 0, e["wrong_pct"], e["ns_per_test"] or 0))
         fewer = [e for e in sa if e["wrong_pct"] < right["wrong_pct"]]
         rule = ("rule: leak-free methods first, then the fewest wrong answers, then the fastest"
@@ -817,6 +841,53 @@ def perf_facts(rep):
         facts.append(f"Most right ({rule}): <b>{esc(right['subject'])}</b> ({fnum(right['wrong_pct'])}% wrong, "
                      f"{right['leaks']:,} leaks){below}")
     return facts
+
+
+def audit_words(m):
+    """The run's real seed and rays, and what each --audit file holds."""
+    inputs = m.get("audit_inputs") or []
+    generated = m["rays_per_family"] not in (None, 0)
+    text = (f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method x precision"
+            if generated else "graded answers on cases given by hand (not generated: no seed)")
+    if len(inputs) > 1 or any(i.get("graded") for i in inputs):
+        parts = []
+        for i in inputs:
+            what = ", ".join(i["subjects"])
+            if i.get("graded"):
+                g = i["graded"]
+                what += f" (answers {g.get('answers', '?')} on the cases {g.get('cases', '?')})"
+            parts.append(f"{os.path.basename(i['file'])}: {what}")
+        text += "; " + "; ".join(parts)
+    return text
+
+
+def merge_audits(paths):
+    """Several audits of the same seed and rays (rayaudit report checked) as one."""
+    merged = None
+    for p in paths:
+        a = load_json(p)
+        entry = {"file": p, "subjects": [s["name"] for s in a["subjects"]], "graded": a.get("graded")}
+        if merged is None:
+            merged = dict(a, subjects=list(a["subjects"]), cells=list(a["cells"]), _inputs=[entry])
+            continue
+        merged["subjects"] += a["subjects"]
+        merged["cells"] += a["cells"]
+        merged["_inputs"].append(entry)
+    return merged
+
+
+def read_timings(path):
+    """subject,ns_per_test (validation/baseline/timing.h) as {subject: ns}."""
+    current_input[0] = path
+    out = {}
+    with open(path, encoding="utf-8-sig") as f:
+        for line in f:
+            line = line.strip()
+            if not line or line.startswith("#") or line == "subject,ns_per_test":
+                continue
+            subject, ns = line.rsplit(",", 1)
+            out[subject] = float(ns)
+    return out
 
 
 def chart_html(svg, caption):
@@ -852,8 +923,7 @@ def page(rep, charts, methods, uris):
             ("Date", m["date"]),
             ("Libraries", ", ".join(f"{k} {v}" for k, v in m["versions"].items()))]
     if rep["have_audit"]:
-        rows.append(("Audit", f"seed {m['seed']}, {m['rays_per_family']} ray/primitive tests per family per method "
-                              "x precision"))
+        rows.append(("Audit", audit_words(m)))
     if rep["have_bench"]:
         rows.append(("Benchmark runs", f"{len(rep['bench_runs'])} JSON(s): {STAMP[0]}"))
     if m["bench_context"]:
@@ -1020,9 +1090,13 @@ def main():
     for k, v in ctx.get("fs_paths", {}).items():
         ctx[k] = [os.fsdecode(bytes.fromhex(h)) for h in v] if isinstance(v, list) else os.fsdecode(bytes.fromhex(v))
     methods = Methods(ctx["methods"])
-    audit = load_json(ctx["audit"]) if ctx.get("audit") else None
+    audit = merge_audits(ctx.get("audits") or ([ctx["audit"]] if ctx.get("audit") else []))
     if audit:
         peer_subjects.register(methods, audit)
+        for s in audit["subjects"]:
+            if not peer_subjects.is_peer(methods, s["method"]):
+                methods.add_user(s["method"])
+    timings = read_timings(ctx["timings"]) if ctx.get("timings") else {}
     bench_paths = ctx.get("bench") or []
     if isinstance(bench_paths, str):
         bench_paths = [bench_paths]
@@ -1053,7 +1127,7 @@ def main():
     rep = {
         "have_bench": bench is not None,
         "have_audit": audit is not None,
-        "speed_accuracy": speed_accuracy(audit, bench, methods) if audit else [],
+        "speed_accuracy": speed_accuracy(audit, bench, methods, timings) if audit else [],
         "stability": stability(audit) if audit else {},
         "crack_maps": crack_maps(cm, cm_dir) if cm else [],
         "crack_meshes": cm["meshes"] if cm else [],
@@ -1069,7 +1143,7 @@ def main():
         "tracers": tracers_report.summary(audit),
     }
     charts = {
-        "speed_accuracy": chart_speed_accuracy(rep["speed_accuracy"], methods, bench is not None),
+        "speed_accuracy": chart_speed_accuracy(rep["speed_accuracy"], methods, bench is not None or bool(timings)),
         "stability": chart_stability(rep["stability"], methods),
         "crack_leaks": chart_crack_leaks(rep["crack_maps"], methods) if rep["crack_maps"] else None,
         "optimisations": chart_optimisations(rep["optimisations"]) if bench else [],
