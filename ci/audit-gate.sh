@@ -9,7 +9,7 @@
 #   ci/audit-gate.sh report      the HTML report            -> $AUDIT_OUT/report/index.html
 #   ci/audit-gate.sh all         every step above, the shards one after another
 #
-# Settings (environment): RAYAUDIT (the program; default build/release/cli/
+# Settings (environment): RAYAUDIT (the program; default build/release/
 # rayaudit beside this script, else rayaudit on PATH), AUDIT_OUT (audit-out),
 # AUDIT_RAYS (200000), AUDIT_SEED (1), AUDIT_SHARDS (4, for `all`),
 # AUDIT_METHODS and AUDIT_FAMILIES (comma lists; default all), AUDIT_REPORT
@@ -23,7 +23,7 @@ set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 if [ -z "${RAYAUDIT:-}" ]; then
-  if [ -x "$here/build/release/cli/rayaudit" ]; then RAYAUDIT="$here/build/release/cli/rayaudit"
+  if [ -x "$here/build/release/rayaudit" ]; then RAYAUDIT="$here/build/release/rayaudit"
   else RAYAUDIT="$(command -v rayaudit || true)"; fi
 fi
 [ -n "$RAYAUDIT" ] && [ -x "$RAYAUDIT" ] || {

@@ -78,13 +78,13 @@ TEST(Mtl, BumpSpellings) {
 
 TEST(Mtl, WarningsAndErrors) {
   std::vector<std::string> w;
-  const auto m = parse("Kd 1 1 1\nnewmtl \nKa spectral x.rfl\nTf 1 1 1\nTf 1 1 1\n", &w);
+  const auto m = parse("Kd 1 1 1\nnewmtl \nKa spectral x.rfl\nKe 1 1 1\nKe 1 1 1\n", &w);
   ASSERT_EQ(m.size(), 1u);
   EXPECT_EQ(m[0].name, "");
   EXPECT_EQ(w, (std::vector<std::string>{"m.mtl:1: statement before the first newmtl ignored",
                                          "m.mtl:2: newmtl without a name (material named '')",
                                          "m.mtl:3: Ka spectral/xyz form is not supported (ignored)",
-                                         "m.mtl:4: unsupported MTL statement 'Tf' ignored"}));
+                                         "m.mtl:4: unsupported MTL statement 'Ke' ignored"}));
   EXPECT_EQ(error_of("newmtl a\nKd 1 2\n"), "m.mtl:2: Kd needs 1 or 3 values (2 given)");
   EXPECT_EQ(error_of("newmtl a\n\nNs abc\n"), "m.mtl:3: malformed number 'abc'");
   EXPECT_EQ(error_of("newmtl a\nmap_Kd -s 1 1 1\n"), "m.mtl:2: texture statement without a file name");
