@@ -73,7 +73,7 @@ TEST(Cli, BadSceneExits2WithFileAndPath) {
 
 // The method names of issue 3, by kind: the CLI's names are a contract.
 const std::vector<std::string> kTriangleMethods = {"angles", "cramer", "areas", "triple",
-                                                   "sameside", "moller", "watertight", "baldwin"};
+                                                   "sameside", "moller", "watertight", "baldwin", "exact"};
 const std::vector<std::string> kSphereMethods = {"kraus", "codeproject", "codeproject-fixed", "stable"};
 
 TEST(Cli, UnknownMethodExits2ListingTheValidOnes) {
@@ -87,7 +87,7 @@ TEST(Cli, UnknownMethodExits2ListingTheValidOnes) {
   EXPECT_FALSE(fs::exists(out));
 }
 
-TEST(Cli, MethodsJsonListsEightTriangleFourSphereAndOnePlaneMethod) {
+TEST(Cli, MethodsJsonListsNineTriangleFourSphereAndOnePlaneMethod) {
   const auto r = ra::test::run_rayaudit("methods --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);

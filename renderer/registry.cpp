@@ -10,6 +10,7 @@
 #include "methods/areas.h"
 #include "methods/baldwin.h"
 #include "methods/cramer.h"
+#include "methods/exact.h"
 #include "methods/moller.h"
 #include "methods/plane.h"
 #include "methods/sameside.h"
@@ -53,6 +54,7 @@ RA_VERTEX_METHOD(TripleM, triple);
 RA_VERTEX_METHOD(SamesideM, sameside);
 RA_VERTEX_METHOD(WatertightM, watertight);
 RA_VERTEX_METHOD(BaldwinM, baldwin);
+RA_VERTEX_METHOD(ExactM, exact);
 #undef RA_VERTEX_METHOD
 
 struct MollerM {
@@ -161,6 +163,9 @@ std::vector<Method> build() {
     x.precompute_bytes_double = sizeof(baldwin::Transform<double>);  // 96
     m.push_back(x);
   }
+  m.push_back(triangle_method<ExactM>(
+      "exact", "Plucker signs (Woop et al. 2013) certified by a filter (Shewchuk 1997, pbrt-v4 gamma), GMP fallback",
+      "decisions of exact arithmetic (closed triangle, closed window); t correctly rounded; GMP where the filter cannot tell"));
   // Spheres.
   m.push_back(sphere_method<KrausF>(
       "kraus", "seeds/001 (ray-sphere)",

@@ -15,7 +15,7 @@ TEST(RegistryMethods, OrderAndKinds) {
   for (const auto& m : methods()) names.push_back(m.name);
   const std::vector<std::string> expected{
       "angles", "cramer",      "areas",             "triple", "sameside", "moller", "watertight",
-      "baldwin", "kraus", "codeproject", "codeproject-fixed", "stable", "plane"};
+      "baldwin", "exact", "kraus", "codeproject", "codeproject-fixed", "stable", "plane"};
   EXPECT_EQ(names, expected);
   EXPECT_EQ(method_names(Kind::sphere), "kraus, codeproject, codeproject-fixed, stable");
   EXPECT_EQ(default_method(Kind::triangle).name, "moller");
