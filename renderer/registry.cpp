@@ -54,7 +54,6 @@ RA_VERTEX_METHOD(TripleM, triple);
 RA_VERTEX_METHOD(SamesideM, sameside);
 RA_VERTEX_METHOD(WatertightM, watertight);
 RA_VERTEX_METHOD(BaldwinM, baldwin);
-RA_VERTEX_METHOD(ExactM, exact);
 #undef RA_VERTEX_METHOD
 
 struct MollerM {
@@ -80,6 +79,32 @@ template <class T> TriangleKernels<T> baldwin_kernels() {
     return baldwin::any(r, *static_cast<const baldwin::Transform<T>*>(pre), cull);
   };
   k.pre_bytes = sizeof(baldwin::Transform<T>);
+  return k;
+}
+
+// exact's prepared path stores the vertices and its triangle terms (the
+// normal in the stage 1b compute type and the permanents): the same answers.
+struct ExactM {
+  template <class T>
+  static std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           bool cull) {
+    return exact::hit(r, a, b, c, cull);
+  }
+  template <class T>
+  static bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
+    return exact::any(r, a, b, c, cull);
+  }
+};
+template <class T> TriangleKernels<T> exact_kernels() {
+  TriangleKernels<T> k = detail::vertex_only_kernels<ExactM, T>();
+  using P = exact::detail::Prepared<T>;
+  k.prepare = [](const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, void* out) {
+    const P p = exact::detail::prepare(a, b, c);
+    std::memcpy(out, &p, sizeof p);
+  };
+  k.hit_pre = [](const Ray<T>& r, const void* pre, bool cull) { return exact::hit(r, *static_cast<const P*>(pre), cull); };
+  k.any_pre = [](const Ray<T>& r, const void* pre, bool cull) { return exact::any(r, *static_cast<const P*>(pre), cull); };
+  k.pre_bytes = sizeof(P);
   return k;
 }
 
@@ -163,9 +188,16 @@ std::vector<Method> build() {
     x.precompute_bytes_double = sizeof(baldwin::Transform<double>);  // 96
     m.push_back(x);
   }
-  m.push_back(triangle_method<ExactM>(
-      "exact", "Plucker signs (Woop et al. 2013) certified by a filter (Shewchuk 1997, pbrt-v4 gamma), GMP fallback",
-      "decisions of exact arithmetic (closed triangle, closed window); t correctly rounded; GMP where the filter cannot tell"));
+  {
+    Method x = make("exact", Kind::triangle,
+                    "Plucker signs (Woop et al. 2013) certified by a filter (Shewchuk 1997, pbrt-v4 gamma), GMP fallback",
+                    "decisions of exact arithmetic (closed triangle, closed window); t faithfully rounded; GMP where the filter cannot tell");
+    x.tri_f = exact_kernels<float>();
+    x.tri_d = exact_kernels<double>();
+    x.precompute_bytes_float = sizeof(exact::detail::Prepared<float>);    // vertices, normal, permanents
+    x.precompute_bytes_double = sizeof(exact::detail::Prepared<double>);
+    m.push_back(x);
+  }
   // Spheres.
   m.push_back(sphere_method<KrausF>(
       "kraus", "seeds/001 (ray-sphere)",

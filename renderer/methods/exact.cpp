@@ -6,12 +6,19 @@
 #include <gmp.h>
 #include <mpfr.h>
 
+#include <atomic>
+
 namespace ra::exact {
 
-Fallbacks& fallbacks() {
-  static thread_local Fallbacks f;
-  return f;
+namespace {
+std::atomic<std::uint64_t> g_extended{0}, g_exact{0};
+}  // namespace
+
+Fallbacks fallbacks() {
+  return {g_extended.load(std::memory_order_relaxed), g_exact.load(std::memory_order_relaxed)};
 }
+void count_extended() { g_extended.fetch_add(1, std::memory_order_relaxed); }
+void count_exact() { g_exact.fetch_add(1, std::memory_order_relaxed); }
 
 namespace {
 
@@ -81,7 +88,107 @@ T round_to(const mpq_t q, Scratch& s) {
   return out;
 }
 
+// ------------------------------------------------- double-double stage ---
+// Double-word arithmetic (Joldes, Muller, Popescu, "Tight and rigorous error
+// bounds for basic building blocks of double-word arithmetic", ACM TOMS 44,
+// 2017; u = 2^-53): two_sum and two_prod (with a correctly rounded fma) are
+// exact; AccurateDWPlusDW (their Alg. 6) errs by at most 3u^2 relative to
+// its exact result, DWTimesDW (Alg. 12, fma) by 5u^2, DWDivDW (Alg. 17) by
+// 15u^2 + 56u^3, all as long as nothing underflows or overflows.
+struct DW {
+  double h = 0, l = 0;
+};
+inline DW two_sum(double a, double b) {
+  const double s = a + b, bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+inline DW fast_two_sum(double a, double b) {  // |a| >= |b|
+  const double s = a + b;
+  return {s, b - (s - a)};
+}
+inline DW two_prod(double a, double b) {
+  const double p = a * b;
+  return {p, std::fma(a, b, -p)};
+}
+inline DW add(DW x, DW y) {  // AccurateDWPlusDW
+  const DW s = two_sum(x.h, y.h), t = two_sum(x.l, y.l);
+  DW v = fast_two_sum(s.h, s.l + t.h);
+  return fast_two_sum(v.h, t.l + v.l);
+}
+inline DW neg(DW x) { return {-x.h, -x.l}; }
+inline DW mul(DW x, DW y) {  // DWTimesDW3
+  const DW c = two_prod(x.h, y.h);
+  const double tl0 = x.l * y.l, tl1 = std::fma(x.h, y.l, tl0), cl2 = std::fma(x.l, y.h, tl1);
+  return fast_two_sum(c.h, c.l + cl2);
+}
+inline DW div(DW x, DW y) {  // DWDivDW2
+  const double th = x.h / y.h;
+  const DW r = mul(y, DW{th, 0});
+  const double ph = x.h - r.h, dl = x.l - r.l, d = ph + dl, tl = d / y.h;
+  return fast_two_sum(th, tl);
+}
+
 }  // namespace
+
+namespace detail {
+
+// t for double inputs in double-word arithmetic, when the long double
+// enclosure could not round it: N = n . A' and D = n . d from exact
+// differences (two_sum), n = e1 x e2 with e1, e2 exact.
+//   n_i: two products (5u^2 each) and an accurate difference (3u^2 of the
+//   result <= the permanent): within 9u^2 Pn_i; N: n_i q_i adds 5u^2 and
+//   the two sums 3u^2 each of partial sums <= PN: |N~ - N| <= 20u^2 PN
+//   (+ second-order terms), taken as 64u^2 PN; D likewise. Underflow:
+//   inputs are <= 2^250 here, so an underflowing rounding (<= 2^-1074)
+//   grows through at most two products by 2^251 each: tau = 2^-560.
+//   t~ = N~ / D~ (15u^2 + 56u^3, taken as 32u^2): with a, b as in exact.h,
+//   |t / t~ - 1| <= 2 (a + b) + 33u^2 < the width w below. When t~.l +- w
+//   stays inside half the gaps either side of t~.h, t rounds to t~.h
+//   (correctly rounded) and lies on t~.h's side of any other double: the
+//   window [tlo, thi] is then decided when t~.h != tlo, thi.
+Dist t_double_word(const Ray<double>& r, const Vec3<double>& a, const Vec3<double>& b, const Vec3<double>& c,
+                   double& t_out) {
+  const double big = 0x1p250;
+  for (const Vec3<double>* v : {&r.o, &r.d, &a, &b, &c})
+    if (!(std::abs(v->x) <= big && std::abs(v->y) <= big && std::abs(v->z) <= big)) return Dist::undecided;
+  DW e1[3], e2[3], q[3], n[3];
+  double pn[3];
+  for (int i = 0; i < 3; ++i) {
+    e1[i] = two_sum(b[i], -a[i]);
+    e2[i] = two_sum(c[i], -a[i]);
+    q[i] = two_sum(a[i], -r.o[i]);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    n[i] = add(mul(e1[j], e2[k]), neg(mul(e1[k], e2[j])));
+    pn[i] = std::abs(e1[j].h * e2[k].h) + std::abs(e1[k].h * e2[j].h);
+  }
+  DW N = mul(n[0], q[0]), D = mul(n[0], DW{r.d.x, 0});
+  for (int i = 1; i < 3; ++i) {
+    N = add(N, mul(n[i], q[i]));
+    D = add(D, mul(n[i], DW{r.d[i], 0}));
+  }
+  constexpr double u2 = 0x1p-106, tau = 0x1p-560;
+  // The permanents from the high parts, inflated for the low parts' 2^-52
+  // and the products' roundings (1 + 2^-40).
+  const double PN = (pn[0] * std::abs(q[0].h) + pn[1] * std::abs(q[1].h) + pn[2] * std::abs(q[2].h)) * (1 + 0x1p-40);
+  const double PD = (pn[0] * std::abs(r.d.x) + pn[1] * std::abs(r.d.y) + pn[2] * std::abs(r.d.z)) * (1 + 0x1p-40);
+  const double eN = 64 * u2 * PN + tau, eD = 64 * u2 * PD + tau;
+  const double aN = std::abs(N.h), aD = std::abs(D.h);
+  if (!(aN > 4 * eN && aD > 4 * eD)) return Dist::undecided;
+  const DW t = div(N, D);
+  if (!std::isfinite(t.h) || std::abs(t.h) < 0x1p-900) return Dist::undecided;
+  const double w = std::abs(t.h) * ((2 * (eN / aN + eD / aD) + 64 * u2) * (1 + 0x1p-40));
+  const double up = std::nextafter(t.h, INFINITY) - t.h, down = t.h - std::nextafter(t.h, -INFINITY);
+  if (!(t.l + w < 0.5 * up * (1 - 0x1p-40) && t.l - w > -0.5 * down * (1 - 0x1p-40))) return Dist::undecided;
+  const double tlo = std::max(r.tmin, 0.0);
+  if (t.h < tlo || t.h > r.tmax) return Dist::out;
+  if (!(t.h > tlo && t.h < r.tmax)) return Dist::undecided;  // on a window end (or a NaN window)
+  t_out = t.h;
+  return Dist::in;
+}
+
+}  // namespace detail
 
 template <class T>
 std::optional<TriangleHit<T>> hit_exact(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,

@@ -41,10 +41,14 @@
 //  - Every hit/miss verdict is that of exact arithmetic (above). Boundary
 //    crossings (a zero among U, V, W) are hits, so a ray through an edge or
 //    vertex shared by triangles hits all of them: no leak, ever.
-//  - t is CORRECTLY ROUNDED (round to nearest, ties to even) to T: the fast
-//    path returns it only when its whole error enclosure rounds to one value,
-//    the exact path rounds the exact rational with MPFR. So the scalar form,
-//    the BVH's 4-lane form and every machine return the same bits.
+//  - t is FAITHFULLY ROUNDED to T: one of the two T values bracketing the
+//    exact t (at most 1 ulp from it), and correctly rounded (to nearest)
+//    whenever the filter's whole enclosure of t rounds to one value (float
+//    rays, computed in double: all but about 1 in 2^20; double rays, in long
+//    double: about 9 in 10) and always on the exact path (MPFR). The value
+//    is a deterministic function of the inputs: the same operations in the
+//    same order give it, so the BVH's 4-lane leaf (which calls this scalar
+//    code for t) and this scalar form return the same bits.
 //  - b1 = V / det, b2 = W / det, clamped to [0, 1]; from the filter they are
 //    within (errV + b errD) / |det| + 2u of exact (errV, errD the bounds
 //    below, u of the compute type): relative to the triangle's size, about
@@ -93,16 +97,25 @@
 //     |t / t~ - 1| <= (a + b + u) / ((1 - b)(1 - u)) <= 2 (a + b) + 3u,
 //   so t lies in [lo, hi] = t~ -+ |t~| (2 (a + b) + 16u): computing the
 //   width costs at most 4 roundings of a value <= 1.01 |t~| and lo, hi one
-//   each of a value <= 2|t~|, 4u + 2u + ... < 13u, covered by 16u - 3u. The window is decided
-//   when [lo, hi] lies inside it or outside it. Rounding to nearest is
+//   each of a value <= 2|t~|, 4u + 2u + ... < 13u, covered by 16u - 3u.
+//   The window is decided when [lo, hi] lies inside it or outside it. Rounding to nearest is
 //   monotone, so when T(lo) == T(hi) every value in [lo, hi], t among them,
-//   rounds to that one T: t correctly rounded. Otherwise stage 3.
-//   (Float: u = 2^-53 leaves 29 bits for the rounding decision; double:
-//   u = 2^-64 leaves 11, so near 1 in 2^11 / (30 cond) double hits ask for
-//   the exact path, cond = 1 / |cos| of the ray's angle to the normal.)
+//   rounds to that one T: t correctly rounded. Otherwise, when [lo, hi]
+//   lies strictly between the neighbours of q = T(t~), t does too: q is
+//   faithful. Otherwise, for double inputs, stage 2b (exact.cpp,
+//   t_double_word) recomputes N and D in double-word arithmetic from exact
+//   differences (relative error ~2^-100 cond) and rounds t correctly; only
+//   what that cannot settle (t within ~2^-95 of a rounding boundary or of a
+//   window end, or inputs beyond 2^250) goes to stage 3. (Float: u = 2^-53 leaves 29 bits for the
+//   rounding decision; double: u = 2^-64 leaves 11: the enclosure, about
+//   2^-60 (1 + 32 cond) |t| wide, cond = 1 / |cos| of the ray's angle to
+//   the normal, straddles a rounding boundary of 1 in 10 of the kernel
+//   bench's double hits, and is wider than half an ulp, so not even
+//   faithful, only where cond > ~2^5.)
 //
 // Exact fallback (stage 3, exact.cpp): GMP rationals (mpq_t, libgmp-dev)
-// over the inputs' exact values, the same formulas; t rounded by MPFR
+// over the inputs' exact values: U, V, W as above, det = U + V + W and
+// N = [A', B', C'] (the triple product, no edges needed); t rounded by MPFR
 // (mpfr_set_q + mpfr_subnormalize in T's exponent range: correct rounding
 // including subnormals and overflow). Why GMP and not Shewchuk expansions:
 // expansions are exact only while no partial product underflows or
@@ -111,8 +124,8 @@
 // and it runs only for the few tests the filter leaves (its ~1-3 us does
 // not show in the mean). Thread-local scratch: no allocation once warm.
 //
-// Fallback counters (thread-local, `fallbacks()`): how many tests took
-// stage 2 and stage 3, for the audit's per-family rates.
+// Fallback counters (`fallbacks()`): how many tests took stage 2 and stage
+// 3, for the audit's per-family rates (exact_method_audit_test prints them).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -126,12 +139,16 @@
 
 namespace ra::exact {
 
-// Tests on this thread that went past the double filter.
+// Tests (all threads, since the start) that went past the double filter:
+// counted with relaxed atomics on those paths only, so the filter's own
+// path pays nothing.
 struct Fallbacks {
-  std::uint64_t extended = 0;  // signs redone in long double (double inputs only)
+  std::uint64_t extended = 0;  // double inputs: signs redone in long double, or t in double-word
   std::uint64_t exact = 0;     // decided by GMP
 };
-Fallbacks& fallbacks();
+Fallbacks fallbacks();
+void count_extended();
+void count_exact();
 
 // Stage 3: the whole test in exact rational arithmetic (exact.cpp).
 template <class T>
@@ -193,27 +210,59 @@ template <class C, class T>
 // What the distance stage settled.
 enum class Dist { out, in, undecided };
 
-// Stage 1b: t = (n . A') / (n . d) in C with its enclosure (header); `out`
-// when the window is certainly missed, `in` with t_out correctly rounded
-// to T (when need_t) when it is certainly met.
+// The triangle's part of stage 1b, the same for every ray (the prepared
+// form stores it): the normal n = e1 x e2 in C from edges rounded once in
+// C, and the permanents Pn_i = |e1_j e2_k| + |e1_k e2_j| in double (SSE,
+// cheaper than x87 where C is long double): their factors are differences
+// rounded once (relative error <= 2^-53), then <= 5 roundings: within
+// (1 + 2^-50) of the permanents of exact values (the 1 + 2^-48 below).
+// Double inputs: the permanents are sound only without underflow or
+// overflow, so every factor must be 0 or within [2^-300, 2^300] (float
+// inputs always are, as stage 1's range note says); otherwise pn[0] is NaN
+// and stage 1b never decides.
+template <class C>
+struct Edges {
+  C n[3];
+  double pn[3];
+};
+inline bool tame(double x) { return x == 0 || (std::abs(x) >= 0x1p-300 && std::abs(x) <= 0x1p300); }
 template <class C, class T>
-[[gnu::always_inline]] inline Dist enclose_t(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                                             bool need_t, T& t_out) {
+[[gnu::always_inline]] inline Edges<C> edges(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
   const C ax = C(a.x), ay = C(a.y), az = C(a.z);
   const C e1x = C(b.x) - ax, e1y = C(b.y) - ay, e1z = C(b.z) - az;
   const C e2x = C(c.x) - ax, e2y = C(c.y) - ay, e2z = C(c.z) - az;
-  const C nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
-  const C px = std::abs(e1y * e2z) + std::abs(e1z * e2y), py = std::abs(e1z * e2x) + std::abs(e1x * e2z),
-          pz = std::abs(e1x * e2y) + std::abs(e1y * e2x);
-  const C qx = ax - C(r.o.x), qy = ay - C(r.o.y), qz = az - C(r.o.z);
-  const C dx = C(r.d.x), dy = C(r.d.y), dz = C(r.d.z);
-  const C N = nx * qx + ny * qy + nz * qz;
-  const C D = nx * dx + ny * dy + nz * dz;
-  constexpr C u = unit_roundoff<C>(), k = C(16) * u;
-  const C eN = k * (px * std::abs(qx) + py * std::abs(qy) + pz * std::abs(qz));
-  const C eD = k * (px * std::abs(dx) + py * std::abs(dy) + pz * std::abs(dz));
+  Edges<C> e;
+  e.n[0] = e1y * e2z - e1z * e2y, e.n[1] = e1z * e2x - e1x * e2z, e.n[2] = e1x * e2y - e1y * e2x;
+  const double fe1x = double(b.x) - double(a.x), fe1y = double(b.y) - double(a.y), fe1z = double(b.z) - double(a.z);
+  const double fe2x = double(c.x) - double(a.x), fe2y = double(c.y) - double(a.y), fe2z = double(c.z) - double(a.z);
+  e.pn[0] = std::abs(fe1y * fe2z) + std::abs(fe1z * fe2y);
+  e.pn[1] = std::abs(fe1z * fe2x) + std::abs(fe1x * fe2z);
+  e.pn[2] = std::abs(fe1x * fe2y) + std::abs(fe1y * fe2x);
+  if constexpr (sizeof(T) == sizeof(double))
+    if (!(tame(fe1x) && tame(fe1y) && tame(fe1z) && tame(fe2x) && tame(fe2y) && tame(fe2z)))
+      e.pn[0] = std::numeric_limits<double>::quiet_NaN();
+  return e;
+}
+
+// Stage 1b: t = (n . A') / (n . d) in C with its enclosure (header); `out`
+// when the window is certainly missed, `in` with t_out (when need_t)
+// correctly or faithfully rounded to T when it is certainly met.
+template <class C, class T>
+[[gnu::always_inline]] inline Dist enclose_t(const Ray<T>& r, const Vec3<T>& a, const Edges<C>& e, bool need_t,
+                                             T& t_out) {
+  const C qx = C(a.x) - C(r.o.x), qy = C(a.y) - C(r.o.y), qz = C(a.z) - C(r.o.z);
+  const C N = e.n[0] * qx + e.n[1] * qy + e.n[2] * qz;
+  const C D = e.n[0] * C(r.d.x) + e.n[1] * C(r.d.y) + e.n[2] * C(r.d.z);
+  const double fqx = double(a.x) - double(r.o.x), fqy = double(a.y) - double(r.o.y), fqz = double(a.z) - double(r.o.z);
+  double PN = e.pn[0] * std::abs(fqx) + e.pn[1] * std::abs(fqy) + e.pn[2] * std::abs(fqz);
+  const double PD = e.pn[0] * std::abs(double(r.d.x)) + e.pn[1] * std::abs(double(r.d.y)) + e.pn[2] * std::abs(double(r.d.z));
+  if constexpr (sizeof(T) == sizeof(double))
+    if (!(tame(fqx) && tame(fqy) && tame(fqz) && tame(r.d.x) && tame(r.d.y) && tame(r.d.z)))
+      PN = std::numeric_limits<double>::quiet_NaN();
+  constexpr C u = unit_roundoff<C>(), k = C(16) * u * C(1 + 0x1p-48);
+  const C eN = k * C(PN), eD = k * C(PD);
   const C aN = std::abs(N), aD = std::abs(D);
-  if (!(aN > C(4) * eN && aD > C(4) * eD)) return Dist::undecided;  // t near 0, or grazing (also NaN)
+  if (!(aN > C(4) * eN && aD > C(4) * eD)) return Dist::undecided;  // t near 0, grazing, untamed (NaN)
   const C t = N / D;
   const C w = std::abs(t) * (C(2) * (eN / aN + eD / aD) + C(16) * u);
   const C lo = t - w, hi = t + w;
@@ -221,12 +270,23 @@ template <class C, class T>
   if (hi < tlo || lo > thi) return Dist::out;
   if (!(lo >= tlo && hi <= thi)) return Dist::undecided;  // on the window's edge (or a NaN window)
   if (need_t) {
-    const T rl = T(lo), rh = T(hi);
-    if (rl != rh) return Dist::undecided;  // t near a rounding boundary
-    t_out = rl;
+    // Correctly rounded when the whole enclosure rounds to one T; else
+    // faithful when it lies strictly between the neighbours of T(t~): t is
+    // then within 1 ulp of the T returned, on no far side of a neighbour.
+    const T q = T(t);
+    if (T(lo) != T(hi) &&
+        !(std::isfinite(q) && lo > C(std::nextafter(q, T(-INFINITY))) && hi < C(std::nextafter(q, T(INFINITY)))))
+      return Dist::undecided;
+    t_out = q;
   }
   return Dist::in;
 }
+
+// Stage 2b (exact.cpp), double inputs: t in double-word arithmetic where
+// the long double enclosure was too wide to round; `in` only with t
+// correctly rounded.
+Dist t_double_word(const Ray<double>& r, const Vec3<double>& a, const Vec3<double>& b, const Vec3<double>& c,
+                   double& t_out);
 
 // The barycentrics from the certified Plücker values, clamped to [0, 1].
 template <class C, class T>
@@ -236,11 +296,18 @@ template <class C, class T>
   return TriangleHit<T>{t, T(b1), T(b2)};
 }
 
-// The test; need_t = false for any-hit (the verdict only).
+// The compute type of stage 1b: double for float inputs, long double for double.
+template <class T>
+using TCompute = std::conditional_t<sizeof(T) == sizeof(float), double, long double>;
+
+// The test; need_t = false for any-hit (the verdict only). `pre`: the
+// triangle's stage 1b terms if prepared (the same values edges() gives).
 template <class T>
 [[gnu::always_inline]] inline std::optional<TriangleHit<T>> test(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                                                const Vec3<T>& c, bool cull, bool need_t) {
+                                                                const Vec3<T>& c, const Edges<TCompute<T>>* pre,
+                                                                bool cull, bool need_t) {
   constexpr bool kFloat = sizeof(T) == sizeof(float);
+  using C = TCompute<T>;
   // Double inputs: the double filter's range guard and underflow term.
   constexpr double kLimit = kFloat ? std::numeric_limits<double>::infinity() : 0x1p330;
   constexpr double kTau = kFloat ? 0.0 : 0x1p-736;
@@ -251,28 +318,41 @@ template <class T>
   if (sg == Signs::inside) {
     if (cull && s > 0) return std::nullopt;
     T t{};
-    using C = std::conditional_t<kFloat, double, long double>;
-    const Dist ds = enclose_t<C>(r, a, b, c, need_t, t);
+    Dist ds = pre ? enclose_t<C>(r, a, *pre, need_t, t) : enclose_t<C>(r, a, edges<C>(a, b, c), need_t, t);
+    if constexpr (!kFloat)
+      if (ds == Dist::undecided) count_extended(), ds = t_double_word(r, a, b, c, t);
     if (ds == Dist::out) return std::nullopt;
     if (ds == Dist::in) return finish<double, T>(t, U, V, W);
-    ++fallbacks().exact;
+    count_exact();
     return hit_exact(r, a, b, c, cull);
   }
   if constexpr (!kFloat) {
-    ++fallbacks().extended;
+    count_extended();
     long double Ul, Vl, Wl;
     const Signs sl = signs<long double>(r, a, b, c, std::numeric_limits<long double>::infinity(), 0.0L, Ul, Vl, Wl, s);
     if (sl == Signs::miss) return std::nullopt;
     if (sl == Signs::inside) {
       if (cull && s > 0) return std::nullopt;
       T t{};
-      const Dist ds = enclose_t<long double>(r, a, b, c, need_t, t);
+      Dist ds = enclose_t<C>(r, a, pre ? *pre : edges<C>(a, b, c), need_t, t);
+      if (ds == Dist::undecided) ds = t_double_word(r, a, b, c, t);
       if (ds == Dist::out) return std::nullopt;
       if (ds == Dist::in) return finish<long double, T>(t, Ul, Vl, Wl);
     }
   }
-  ++fallbacks().exact;
+  count_exact();
   return hit_exact(r, a, b, c, cull);
+}
+
+// The prepared form: the vertices and the triangle's stage 1b terms.
+template <class T>
+struct Prepared {
+  Vec3<T> a, b, c;
+  Edges<TCompute<T>> e;
+};
+template <class T>
+Prepared<T> prepare(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
+  return {a, b, c, edges<TCompute<T>>(a, b, c)};
 }
 
 }  // namespace detail
@@ -280,12 +360,22 @@ template <class T>
 template <class T>
 std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
                                   bool cull) {
-  return detail::test(r, a, b, c, cull, true);
+  return detail::test(r, a, b, c, nullptr, cull, true);
 }
 
 template <class T>
 bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
-  return detail::test(r, a, b, c, cull, false).has_value();
+  return detail::test(r, a, b, c, nullptr, cull, false).has_value();
+}
+
+// The same from the prepared form (bit for bit the same answers).
+template <class T>
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const detail::Prepared<T>& p, bool cull) {
+  return detail::test(r, p.a, p.b, p.c, &p.e, cull, true);
+}
+template <class T>
+bool any(const Ray<T>& r, const detail::Prepared<T>& p, bool cull) {
+  return detail::test(r, p.a, p.b, p.c, &p.e, cull, false).has_value();
 }
 
 }  // namespace ra::exact
