@@ -14,9 +14,7 @@ namespace {
 std::atomic<std::uint64_t> g_extended{0}, g_exact{0};
 }  // namespace
 
-Fallbacks fallbacks() {
-  return {g_extended.load(std::memory_order_relaxed), g_exact.load(std::memory_order_relaxed)};
-}
+Fallbacks fallbacks() { return {g_extended.load(std::memory_order_relaxed), g_exact.load(std::memory_order_relaxed)}; }
 void count_extended() { g_extended.fetch_add(1, std::memory_order_relaxed); }
 void count_exact() { g_exact.fetch_add(1, std::memory_order_relaxed); }
 
@@ -213,7 +211,7 @@ std::optional<TriangleHit<T>> hit_exact(const Ray<T>& r, const Vec3<T>& a, const
   triple(s.W, d, A, B, s.x, s.y);
   const int su = mpq_sgn(s.U), sv = mpq_sgn(s.V), sw = mpq_sgn(s.W);
   const bool pos = su > 0 || sv > 0 || sw > 0, neg = su < 0 || sv < 0 || sw < 0;
-  if (pos == neg) return std::nullopt;  // opposite signs, or all zero (det = 0)
+  if (pos == neg) return std::nullopt;   // opposite signs, or all zero (det = 0)
   if (cull && pos) return std::nullopt;  // det = n . d > 0: the back face
   mpq_add(s.det, s.U, s.V);
   mpq_add(s.det, s.det, s.W);

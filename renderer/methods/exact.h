@@ -154,8 +154,8 @@ void count_exact();
 template <class T>
 std::optional<TriangleHit<T>> hit_exact(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
                                         bool cull);
-extern template std::optional<TriangleHit<float>> hit_exact(const Ray<float>&, const Vec3<float>&,
-                                                            const Vec3<float>&, const Vec3<float>&, bool);
+extern template std::optional<TriangleHit<float>> hit_exact(const Ray<float>&, const Vec3<float>&, const Vec3<float>&,
+                                                            const Vec3<float>&, bool);
 extern template std::optional<TriangleHit<double>> hit_exact(const Ray<double>&, const Vec3<double>&,
                                                              const Vec3<double>&, const Vec3<double>&, bool);
 
@@ -200,7 +200,7 @@ template <class C, class T>
   constexpr C k = C(16) * unit_roundoff<C>();
   const C ksd = k * sd;
   const C eU = ksd * mb * mc + tau, eV = ksd * mc * ma + tau, eW = ksd * ma * mb + tau;
-  const bool pu = U > eU, nu = U < -eU, pv = V > eV, nv = V < -eV, pw = W > eW, nw = W < -eW;
+  const bool pu = U > eU, nu = U<-eU, pv = V> eV, nv = V<-eV, pw = W> eW, nw = W < -eW;
   if ((pu | pv | pw) & (nu | nv | nw)) return Signs::miss;  // two certified opposite signs
   if (pu & pv & pw) return s = 1, Signs::inside;
   if (nu & nv & nw) return s = -1, Signs::inside;
@@ -255,7 +255,8 @@ template <class C, class T>
   const C D = e.n[0] * C(r.d.x) + e.n[1] * C(r.d.y) + e.n[2] * C(r.d.z);
   const double fqx = double(a.x) - double(r.o.x), fqy = double(a.y) - double(r.o.y), fqz = double(a.z) - double(r.o.z);
   double PN = e.pn[0] * std::abs(fqx) + e.pn[1] * std::abs(fqy) + e.pn[2] * std::abs(fqz);
-  const double PD = e.pn[0] * std::abs(double(r.d.x)) + e.pn[1] * std::abs(double(r.d.y)) + e.pn[2] * std::abs(double(r.d.z));
+  const double PD =
+      e.pn[0] * std::abs(double(r.d.x)) + e.pn[1] * std::abs(double(r.d.y)) + e.pn[2] * std::abs(double(r.d.z));
   if constexpr (sizeof(T) == sizeof(double))
     if (!(tame(fqx) && tame(fqy) && tame(fqz) && tame(r.d.x) && tame(r.d.y) && tame(r.d.z)))
       PN = std::numeric_limits<double>::quiet_NaN();
@@ -267,7 +268,8 @@ template <class C, class T>
   constexpr double k = double(16 * u) * (1 + 0x1p-48);
   const double eN = k * PN, eD = k * PD;
   const double aN = double(std::abs(N)), aD = double(std::abs(D));
-  if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD)) return Dist::undecided;  // t near 0, grazing, untamed (NaN)
+  if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD))
+    return Dist::undecided;  // t near 0, grazing, untamed (NaN)
   const C t = N / D;
   const double rel = (eN * aD + eD * aN) / (aN * aD) * (2 * (1 + 0x1p-40));
   const C w = std::abs(t) * (C(rel) + C(16) * u);
@@ -310,8 +312,8 @@ using TCompute = std::conditional_t<sizeof(T) == sizeof(float), double, long dou
 // triangle's stage 1b terms if prepared (the same values edges() gives).
 template <class T>
 [[gnu::always_inline]] inline std::optional<TriangleHit<T>> test(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                                                const Vec3<T>& c, const Edges<TCompute<T>>* pre,
-                                                                bool cull, bool need_t) {
+                                                                 const Vec3<T>& c, const Edges<TCompute<T>>* pre,
+                                                                 bool cull, bool need_t) {
   constexpr bool kFloat = sizeof(T) == sizeof(float);
   using C = TCompute<T>;
   // Double inputs: the double filter's range guard and underflow term.
@@ -364,8 +366,7 @@ Prepared<T> prepare(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
 }  // namespace detail
 
 template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                                  bool cull) {
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
   return detail::test(r, a, b, c, nullptr, cull, true);
 }
 

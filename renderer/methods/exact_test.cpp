@@ -36,8 +36,8 @@ TYPED_TEST(ExactTyped, EdgesAndVerticesBelongToTheTriangle) {
   using T = TypeParam;
   const Unit<T> u;
   // Vertices, edge midpoints and an interior point: all hits at t = 1.
-  for (const Vec3<T> p : {u.a, u.b, u.c, Vec3<T>{T(0.5), 0, 1}, Vec3<T>{0, T(0.5), 1},
-                          Vec3<T>{T(0.5), T(0.5), 1}, Vec3<T>{T(0.25), T(0.25), 1}}) {
+  for (const Vec3<T> p : {u.a, u.b, u.c, Vec3<T>{T(0.5), 0, 1}, Vec3<T>{0, T(0.5), 1}, Vec3<T>{T(0.5), T(0.5), 1},
+                          Vec3<T>{T(0.25), T(0.25), 1}}) {
     const auto h = hit(Ray<T>{{0, 0, 0}, p}, u.a, u.b, u.c);
     ASSERT_TRUE(h.has_value()) << p;
     EXPECT_EQ(h->t, T(1)) << p;
@@ -79,8 +79,7 @@ TYPED_TEST(ExactTyped, SharedVertexHitsTheWholeFan) {
   std::uniform_int_distribution<int> grid(-64, 64);
   const Vec3<T> v{T(0.5), T(0.25), T(0.125)};
   Vec3<T> ring[6];
-  for (int k = 0; k < 6; ++k)
-    ring[k] = v + Vec3<T>{T(std::cos(k * 1.047)), T(std::sin(k * 1.047)), T(0.1) * T(k % 2)};
+  for (int k = 0; k < 6; ++k) ring[k] = v + Vec3<T>{T(std::cos(k * 1.047)), T(std::sin(k * 1.047)), T(0.1) * T(k % 2)};
   for (int i = 0; i < 2000; ++i) {
     const Vec3<T> o{T(grid(g)) / 16, T(grid(g)) / 16, T(grid(g)) / 16 + 5};
     const Ray<T> ray{o, v - o};  // exact: small dyadic numbers
@@ -229,8 +228,8 @@ TYPED_TEST(ExactTyped, NonFiniteInputsAndDegenerateTrianglesMiss) {
   Ray<T> nw = r;
   nw.tmax = nan;
   EXPECT_FALSE(hit(nw, u.a, u.b, u.c).has_value());
-  EXPECT_FALSE(hit(r, u.a, u.a, u.c).has_value());                    // two equal vertices
-  EXPECT_FALSE(hit(r, u.a, Vec3<T>{T(0.5), 0, 1}, u.b).has_value());  // collinear
+  EXPECT_FALSE(hit(r, u.a, u.a, u.c).has_value());                             // two equal vertices
+  EXPECT_FALSE(hit(r, u.a, Vec3<T>{T(0.5), 0, 1}, u.b).has_value());           // collinear
   EXPECT_FALSE(hit(Ray<T>{{0, 0, 0}, {0, 0, 0}}, u.a, u.b, u.c).has_value());  // d = 0
 }
 

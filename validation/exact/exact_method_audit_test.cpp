@@ -32,8 +32,8 @@ TEST(ExactMethodAudit, NoErrorsOnAnyFamilyAndFallbackRates) {
       const Stats s = r.total(0);
       const double n = double(s.tests);
       std::printf("exact/%s %-12s tests %7llu  stage 2 (long double) %6.3f%%  stage 3 (GMP) %6.3f%%\n",
-                  precision_name(p), f.name.c_str(), (unsigned long long)(s.tests), 100.0 * double(after.extended - before.extended) / n,
-                  100.0 * double(after.exact - before.exact) / n);
+                  precision_name(p), f.name.c_str(), (unsigned long long)(s.tests),
+                  100.0 * double(after.extended - before.extended) / n, 100.0 * double(after.exact - before.exact) / n);
       EXPECT_GT(s.tests, 0u) << f.name;
       EXPECT_EQ(s.false_hits, 0u) << f.name << " " << precision_name(p);
       EXPECT_EQ(s.false_misses, 0u) << f.name << " " << precision_name(p);
