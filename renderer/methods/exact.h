@@ -45,10 +45,10 @@
 //    exact t (at most 1 ulp from it), and correctly rounded (to nearest)
 //    whenever the filter's whole enclosure of t rounds to one value (float
 //    rays, computed in double: all but about 1 in 2^20; double rays, in long
-//    double: about 9 in 10) and always on the exact path (MPFR). The value
-//    is a deterministic function of the inputs: the same operations in the
-//    same order give it, so the BVH's 4-lane leaf (which calls this scalar
-//    code for t) and this scalar form return the same bits.
+//    double: about 9 in 10) and always on the exact path (MPFR). The
+//    value is a deterministic function of the inputs (the same operations
+//    in the same order), so the direct and the prepared forms return the
+//    same bits (exact_test.cpp checks it).
 //  - b1 = V / det, b2 = W / det, clamped to [0, 1]; from the filter they are
 //    within (errV + b errD) / |det| + 2u of exact (errV, errD the bounds
 //    below, u of the compute type): relative to the triangle's size, about
@@ -126,6 +126,11 @@
 //
 // Fallback counters (`fallbacks()`): how many tests took stage 2 and stage
 // 3, for the audit's per-family rates (exact_method_audit_test prints them).
+// Measured (2-core shared machine; renderer/methods/README.md has the
+// table): `rayaudit audit --methods exact --rays 1000000` 0 in every error
+// column, float and double (t at most 1 ulp from the oracle's); kernel
+// bench (hit=50, back=50, nocull) 1.18x watertight's ns per test in float,
+// 1.86x in double (the x87 stage); crack maps 0 leaks, 0 false pixels.
 #pragma once
 #include <algorithm>
 #include <cmath>
