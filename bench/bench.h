@@ -102,7 +102,9 @@ struct BuiltTracer {
   double build_s = 0;
   double bytes_per_triangle = 0;
 };
-BuiltTracer& our_tracer(const Rung& r, ra::Accel accel, bool cull);
+// `method`: the registry's triangle method (moller, the default, has the
+// BVH's 4-lane leaves).
+BuiltTracer& our_tracer(const Rung& r, ra::Accel accel, bool cull, const std::string& method = "moller");
 
 // At most `max_rays` of the rays, evenly spread over the set (all if fewer).
 std::vector<ra::Rayd> subset(const std::vector<ra::Rayd>& rays, std::size_t max_rays);

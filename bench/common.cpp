@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <tuple>
 #include <mutex>
 
 #include "bench.h"
@@ -110,7 +111,7 @@ namespace {
 struct Kept {
   const Rung* rung = nullptr;
   RungRays rays;
-  std::map<std::pair<int, bool>, BuiltTracer> tracers;
+  std::map<std::tuple<int, bool, std::string>, BuiltTracer> tracers;
 };
 Kept& kept() {
   static Kept k;
@@ -175,14 +176,15 @@ RungRays& rung_rays(const Rung& r) {
   return rr;
 }
 
-BuiltTracer& our_tracer(const Rung& r, ra::Accel accel, bool cull) {
+BuiltTracer& our_tracer(const Rung& r, ra::Accel accel, bool cull, const std::string& method) {
   RungRays& rr = rung_rays(r);
-  auto& slot = kept().tracers[{int(accel), cull}];
+  auto& slot = kept().tracers[{int(accel), cull, method}];
   if (slot.tracer) return slot;
   ra::RenderOptions opt;
   opt.progress = false;
   opt.accel = accel;
   opt.cull = cull;
+  opt.triangle_method = method;
   const long before = heap_live();
   const auto t0 = now();
   slot.tracer = std::make_unique<ra::Tracer>(*rr.scene, opt);

@@ -177,12 +177,13 @@ void bm_build(benchmark::State& state, const Rung* rung, bool robust, int thread
   state.counters["ratio"] = theirs / ours;  // builds per second, ours / Embree's
 }
 
-void bm_trace(benchmark::State& state, const Rung* rung, bool robust, bool shadow, int threads) {
+void bm_trace(benchmark::State& state, const Rung* rung, bool robust, bool shadow, int threads,
+              const std::string& method = "moller") {
   RungRays& rr = rung_rays(*rung);
   // --quick: an evenly spread subset, at most 2^18 rays.
   const std::vector<ra::Rayd> rays =
       subset(shadow ? rr.shadow : rr.primary, config().quick ? std::size_t(1) << 18 : std::size_t(kWidth) * kHeight);
-  const ra::Tracer& ours = *our_tracer(*rung, ra::Accel::bvh, false).tracer;
+  const ra::Tracer& ours = *our_tracer(*rung, ra::Accel::bvh, false, method).tracer;
   EmbreeScene& es = scene_for(*rung, robust, threads);
   double ours_s = 0, theirs_s = 0;
   std::size_t hits = 0, ours_hits = 0, differ = 0;
@@ -228,6 +229,11 @@ void register_embree() {
           add("peer/embree/" + r->name + (shadow ? "/shadow" : "/primary") + tail, needs,
               [=](benchmark::State& s) { bm_trace(s, r, robust, shadow, t); });
       }
+    // Our tracer on the exact method (exact decisions), against Embree's
+    // default build on one thread: the rows its ratio target is set for.
+    for (bool shadow : {false, true})
+      add("peer/embree/" + r->name + (shadow ? "/shadow" : "/primary") + "/exact/default/threads=1", needs,
+          [=](benchmark::State& s) { bm_trace(s, r, false, shadow, 1, "exact"); });
   }
 }
 

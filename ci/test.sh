@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Command 2 of the README (and what .ci/run runs): install what is missing,
-# build, fetch the mesh corpus into the cache, run the whole test suite
+# build, check the formatting, fetch the mesh corpus into the cache, run the whole test suite
 # through ctest, again on the asan preset (ASan + UBSan; ci/asan.sh), then a
 # 30-second libFuzzer run per parser. Idempotent. Each stage prints its wall
 # and CPU time (the budget: 30 minutes on 2 cores).
@@ -24,6 +24,9 @@ if [ -n "${CI:-}" ]; then
   trap 'rm -rf "$RAYAUDIT_CACHE"' EXIT
   step "CI is set: a new, empty corpus cache in $RAYAUDIT_CACHE"
 fi
+
+step "checking the C++ formatting (ci/format-check.sh: clang-format --dry-run -Werror over every tracked file)"
+timed format ci/format-check.sh
 
 step "fetching the mesh corpus into ${RAYAUDIT_CACHE:-$HOME/.cache/rayaudit}/corpus (ci/fetch-corpus.sh)"
 timed corpus ci/fetch-corpus.sh "$RAYAUDIT"

@@ -66,7 +66,7 @@ TEST(Cli, BadSceneExits2WithFileAndPath) {
 
 // The documents' method names and the modern references', by kind: the CLI's names are a contract.
 const std::vector<std::string> kTriangleMethods = {"angles", "cramer", "areas", "triple",
-                                                   "sameside", "moller", "watertight", "baldwin"};
+                                                   "sameside", "moller", "watertight", "baldwin", "exact"};
 const std::vector<std::string> kSphereMethods = {"kraus", "codeproject", "codeproject-fixed", "stable"};
 
 TEST(Cli, UnknownMethodExits2ListingTheValidOnes) {
@@ -80,7 +80,7 @@ TEST(Cli, UnknownMethodExits2ListingTheValidOnes) {
   EXPECT_FALSE(fs::exists(out));
 }
 
-TEST(Cli, MethodsJsonListsEightTriangleFourSphereAndOnePlaneMethod) {
+TEST(Cli, MethodsJsonListsNineTriangleFourSphereAndOnePlaneMethod) {
   const auto r = ra::test::run_rayaudit("methods --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);

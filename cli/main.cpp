@@ -37,10 +37,13 @@ void refuse_empty_values(CLI::App& app) {
 // disk exited 0 and left f empty. Both streams are flushed
 // and checked before a success is reported.
 int finish(int code) {
+  // An output over stdio's buffer (4 KiB: `methods --json` since the exact
+  // method) fails in an earlier write, whose reason is still in errno.
+  const int earlier = errno;
   errno = 0;
   std::cout.flush();  // into stdio's buffer (synced), written out by the fflush
   const bool flush_failed = std::fflush(stdout) != 0;
-  const int err = errno;  // the reason, when the failing write was this one
+  const int err = errno ? errno : std::ferror(stdout) ? earlier : 0;  // the reason of the failing write
   if (!(flush_failed || std::ferror(stdout) || !std::cout) || code != 0) return code;
   std::cerr << "rayaudit: cannot write to standard output"
             << (err ? std::string(": ") + std::strerror(err) : std::string(" (disk full, or closed)")) << "\n";

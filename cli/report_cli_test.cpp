@@ -343,7 +343,7 @@ TEST(CrackMapsCli, CrackMapsAbsurdWorkIsRefusedWithItsSize) {
   const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + kScenes +
                               "/meshes/tetrahedron.obj --size 1024 --offsets 1,10,100,1000,1e4");
   EXPECT_EQ(r.code, 2) << r.all;
-  EXPECT_EQ(r.err, "crack-maps: 80 maps of 1024x1024 pixels are 83886080 pixels (about 104 core-minutes); the "
+  EXPECT_EQ(r.err, "crack-maps: 90 maps of 1024x1024 pixels are 94371840 pixels (about 117 core-minutes); the "
                    "limit is 16777216: fewer --offsets or --methods, or a smaller --size\n");
   EXPECT_FALSE(fs::exists(dir));
 }

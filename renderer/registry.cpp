@@ -10,6 +10,7 @@
 #include "methods/areas.h"
 #include "methods/baldwin.h"
 #include "methods/cramer.h"
+#include "methods/exact.h"
 #include "methods/moller.h"
 #include "methods/plane.h"
 #include "methods/sameside.h"
@@ -94,6 +95,32 @@ template <class T> TriangleKernels<T> baldwin_kernels() {
   return k;
 }
 
+// exact's prepared path stores the vertices and its triangle terms (the
+// normal in the stage 1b compute type and the permanents): the same answers.
+struct ExactM {
+  template <class T>
+  static std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           bool cull) {
+    return exact::hit(r, a, b, c, cull);
+  }
+  template <class T>
+  static bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
+    return exact::any(r, a, b, c, cull);
+  }
+};
+template <class T> TriangleKernels<T> exact_kernels() {
+  TriangleKernels<T> k = detail::vertex_only_kernels<ExactM, T>();
+  using P = exact::detail::Prepared<T>;
+  k.prepare = [](const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, void* out) {
+    const P p = exact::detail::prepare(a, b, c);
+    std::memcpy(out, &p, sizeof p);
+  };
+  k.hit_pre = [](const Ray<T>& r, const void* pre, bool cull) { return exact::hit(r, *static_cast<const P*>(pre), cull); };
+  k.any_pre = [](const Ray<T>& r, const void* pre, bool cull) { return exact::any(r, *static_cast<const P*>(pre), cull); };
+  k.pre_bytes = sizeof(P);
+  return k;
+}
+
 template <class T, std::optional<SurfaceHit<T>> (*F)(const Ray<T>&, const Vec3<T>&, T)>
 SphereKernels<T> sphere_kernels() {
   SphereKernels<T> k;
@@ -172,6 +199,16 @@ std::vector<Method> build() {
     x.tri_d = baldwin_kernels<double>();
     x.precompute_bytes_float = sizeof(baldwin::Transform<float>);    // 48
     x.precompute_bytes_double = sizeof(baldwin::Transform<double>);  // 96
+    m.push_back(x);
+  }
+  {
+    Method x = make("exact", Kind::triangle,
+                    "Plucker signs (Woop et al. 2013) certified by a filter (Shewchuk 1997, pbrt-v4 gamma), GMP fallback",
+                    "decisions of exact arithmetic (closed triangle, closed window); t faithfully rounded; GMP where the filter cannot tell");
+    x.tri_f = exact_kernels<float>();
+    x.tri_d = exact_kernels<double>();
+    x.precompute_bytes_float = sizeof(exact::detail::Prepared<float>);    // vertices, normal, permanents
+    x.precompute_bytes_double = sizeof(exact::detail::Prepared<double>);
     m.push_back(x);
   }
   // Spheres.

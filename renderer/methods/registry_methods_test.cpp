@@ -15,7 +15,7 @@ TEST(RegistryMethods, OrderAndKinds) {
   for (const auto& m : methods()) names.push_back(m.name);
   const std::vector<std::string> expected{
       "angles", "cramer",      "areas",             "triple", "sameside", "moller", "watertight",
-      "baldwin", "kraus", "codeproject", "codeproject-fixed", "stable", "plane"};
+      "baldwin", "exact", "kraus", "codeproject", "codeproject-fixed", "stable", "plane"};
   EXPECT_EQ(names, expected);
   EXPECT_EQ(method_names(Kind::sphere), "kraus, codeproject, codeproject-fixed, stable");
   EXPECT_EQ(default_method(Kind::triangle).name, "moller");
@@ -41,13 +41,19 @@ TEST(RegistryMethods, KernelsAndMetadataComplete) {
   }
 }
 
-// Only baldwin stores more than the vertices: its 3x4 transform.
+// Only baldwin and exact store more than the vertices: baldwin its 3x4
+// transform, exact its vertices with the normal and its permanents.
 TEST(RegistryMethods, PrecomputeBytes) {
   for (const auto& m : methods()) {
     SCOPED_TRACE(m.name);
     if (m.name == "baldwin") {
       EXPECT_EQ(m.precompute_bytes_float, 12 * sizeof(float));
       EXPECT_EQ(m.precompute_bytes_double, 12 * sizeof(double));
+      EXPECT_EQ(m.tri_f.pre_bytes, m.precompute_bytes_float);
+      EXPECT_EQ(m.tri_d.pre_bytes, m.precompute_bytes_double);
+    } else if (m.name == "exact") {
+      EXPECT_GT(m.precompute_bytes_float, 9 * sizeof(float));
+      EXPECT_GT(m.precompute_bytes_double, 9 * sizeof(double));
       EXPECT_EQ(m.tri_f.pre_bytes, m.precompute_bytes_float);
       EXPECT_EQ(m.tri_d.pre_bytes, m.precompute_bytes_double);
     } else {

@@ -1,0 +1,393 @@
+// exact: ray/triangle decisions equal to exact arithmetic on the given float
+// or double inputs, at floating-point speed. A floating-point filter with
+// proven error bounds decides almost every test; the rest go to exact
+// rational arithmetic (GMP, exact.cpp).
+//
+// Sources. The decision is the Plücker / scalar-triple-product test on
+// vertices translated to the ray origin, as the watertight method (Woop,
+// Benthin, Wald, "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013)
+// evaluates it after its shear, here without the shear and with its signs
+// certified instead of trusted. The certification is a static-plus-dynamic
+// filter in the manner of Shewchuk ("Adaptive Precision Floating-Point
+// Arithmetic and Fast Robust Geometric Predicates", DCG 18, 1997) and of
+// pbrt-v4's gamma(n) bounds (Pharr, Jakob, Humphreys, "Physically Based
+// Rendering", 4th ed., 6.8: gamma(n) = n u / (1 - n u), u the unit roundoff,
+// bounds n chained roundings); error analysis of sums of products as Higham,
+// "Accuracy and Stability of Numerical Algorithms", 2nd ed., 3.1.
+//
+// Semantics (the audit oracle's, validation/exact/oracle.h): the triangle is
+// closed (edges and vertices belong to it), the window is the closed
+// [max(tmin, 0), tmax]; inputs are the exact values of their floats or
+// doubles; a ray with a non-finite input or an empty window misses;
+// degenerate triangles and rays in the triangle's plane miss (the audit
+// accepts either answer there).
+//
+// Derivation. Translate: A' = A - o, B' = B - o, C' = C - o. The line
+// o + t d meets the triangle's plane at the point with barycentrics
+// (U, V, W) / det, where
+//   U = d . (B' x C'),  V = d . (C' x A'),  W = d . (A' x B')
+// are the signed volumes of the line with each edge (Plücker products), and
+//   det = U + V + W = d . n,  n = (B - A) x (C - A)
+// (expand (B'-A') x (C'-A') = B'xC' + C'xA' + A'xB'). The closed triangle is
+// met iff U, V, W are not of opposite signs and not all zero (then det has
+// their common sign and is not zero). The hit distance solves
+// o + t d = (U A + V B + W C) / det: dotting t d = (U A' + V B' + W C') / det
+// with n, and n . A' = n . B' = n . C' (the plane), gives
+//   t = N / det,  N = n . A' = [A', B', C'] (the triple product).
+// The decision is the signs of U, V, W and of N - tlo det, thi det - N;
+// nothing else. Front face: det = n . d < 0 (cull rejects det > 0).
+//
+// Guarantees.
+//  - Every hit/miss verdict is that of exact arithmetic (above). Boundary
+//    crossings (a zero among U, V, W) are hits, so a ray through an edge or
+//    vertex shared by triangles hits all of them: no leak, ever.
+//  - t is FAITHFULLY ROUNDED to T: one of the two T values bracketing the
+//    exact t (at most 1 ulp from it), and correctly rounded (to nearest)
+//    whenever the filter's whole enclosure of t rounds to one value (float
+//    rays, computed in double: all but about 1 in 2^20; double rays, in long
+//    double: about 9 in 10) and always on the exact path (MPFR). The
+//    value is a deterministic function of the inputs (the same operations
+//    in the same order), so the direct and the prepared forms return the
+//    same bits (exact_test.cpp checks it).
+//  - b1 = V / det, b2 = W / det, clamped to [0, 1]; from the filter they are
+//    within (errV + b errD) / |det| + 2u of exact (errV, errD the bounds
+//    below, u of the compute type): relative to the triangle's size, about
+//    2^-46 (double rays) or 2^-24 (float) times |d| max|P - o|^2 / |d . n|,
+//    so larger for grazing rays and small far triangles; from the exact path
+//    within 1 ulp of T.
+//
+// The filter (stage 1, `signs`), in double for both precisions. The
+// products are Plücker values on translated vertices b' = fl(B - o):
+//   b' = B'(1 + e), |e| <= u (exact where the difference is subnormal);
+//   U~ = fl(d . fl(b' x c')): each term d_i b'_j c'_k passes through at most
+//     2 (translations) + 1 (product) + 1 (cross difference) + 1 (times d_i)
+//     + 2 (the sum of three) = 7 roundings, so (Higham 3.1, pbrt's gamma)
+//     |U~ - U| <= gamma(7) sum_i |d_i| (|B'_j C'_k| + |B'_k C'_j|)
+//              <= gamma(7) / ((1 - u)^2 (1 - gamma(4))) * 2 s_d m_b m_c
+//     with s_d = |d|_1, m_b = max_i |b'_i| (computed; their own 4 roundings
+//     are the (1 - gamma(4))), and gamma(7) / (...) < 8 u: errU = 16 u s_d
+//     m_b m_c = 2^-49 s_d m_b m_c (a power of two: the bound's product is
+//     exact but for its own rounding, covered by the margin 8u -> 16u/2).
+//   Range: float inputs in double never overflow or underflow (differences
+//     of floats are multiples of 2^-149 below 2^129; products of three lie
+//     in [2^-447, 2^390], far inside double's normal range), so the bound
+//     is complete. Double inputs are filtered in double only while s_d, m_a,
+//     m_b, m_c <= 2^330 (every product of three then < 2^994: no overflow);
+//     underflow adds at most 2^-1075 a rounding, amplified by |d_i| <=
+//     2^330, so the bound gains tau = 2^-736 >= 2^(330+5) 2^-1075. Beyond
+//     the range, or where a sign is not certified, stage 2 redoes the signs
+//     in long double (x87, u = 2^-64, exponent to 2^16383: products of three
+//     or four doubles neither overflow nor underflow, tau = 0), and stage 3
+//     is exact.
+// Certified: |U~| > errU gives sign(U). Two certified opposite signs: a
+// miss (most misses end here). All three certified one sign: a crossing
+// strictly inside; anything else goes on.
+//
+// The distance (stage 1b, `enclose_t`), in double for float inputs and long
+// double for double inputs (both range-safe as above), from the well
+// conditioned form t = (n . A') / (n . d) with n from the triangle's own
+// edges (independent of the ray's distance, unlike [A', B', C']):
+//   e1 = fl(B - A), e2 = fl(C - A), n~ = fl(e1 x e2): each term of N = n.A'
+//   passes through 2 + 1 + 1 (n) + 1 (A') + 1 (product) + 2 (sum) = 8
+//   roundings, of D = n.d through 7, so
+//     |N~ - N| <= gamma(8) sum_i Pn_i |A'_i|,  |D~ - D| <= gamma(7) sum_i Pn_i |d_i|,
+//   Pn_i = |e1_j e2_k| + |e1_k e2_j|; with the same accounting of computed
+//   magnitudes as above, errN = 16 u PN~, errD = 16 u PD~.
+//   With a = errN / |N~| <= 1/4 and b = errD / |D~| <= 1/4, t~ = fl(N~ / D~):
+//     |t / t~ - 1| <= (a + b + u) / ((1 - b)(1 - u)) <= 2 (a + b) + 3u,
+//   so t lies in [lo, hi] = t~ -+ |t~| (2 (a + b) + 16u): computing the
+//   width costs at most 4 roundings of a value <= 1.01 |t~| and lo, hi one
+//   each of a value <= 2|t~|, 4u + 2u + ... < 13u, covered by 16u - 3u.
+//   The window is decided when [lo, hi] lies inside it or outside it. Rounding to nearest is
+//   monotone, so when T(lo) == T(hi) every value in [lo, hi], t among them,
+//   rounds to that one T: t correctly rounded. Otherwise, when [lo, hi]
+//   lies strictly between the neighbours of q = T(t~), t does too: q is
+//   faithful. Otherwise, for double inputs, stage 2b (exact.cpp,
+//   t_double_word) recomputes N and D in double-word arithmetic from exact
+//   differences (relative error ~2^-100 cond) and rounds t correctly; only
+//   what that cannot settle (t within ~2^-95 of a rounding boundary or of a
+//   window end, or inputs beyond 2^250) goes to stage 3. (Float: u = 2^-53 leaves 29 bits for the
+//   rounding decision; double: u = 2^-64 leaves 11: the enclosure, about
+//   2^-60 (1 + 32 cond) |t| wide, cond = 1 / |cos| of the ray's angle to
+//   the normal, straddles a rounding boundary of 1 in 10 of the kernel
+//   bench's double hits, and is wider than half an ulp, so not even
+//   faithful, only where cond > ~2^5.)
+//
+// Exact fallback (stage 3, exact.cpp): GMP rationals (mpq_t, libgmp-dev)
+// over the inputs' exact values: U, V, W as above, det = U + V + W and
+// N = [A', B', C'] (the triple product, no edges needed); t rounded by MPFR
+// (mpfr_set_q + mpfr_subnormalize in T's exponent range: correct rounding
+// including subnormals and overflow). Why GMP and not Shewchuk expansions:
+// expansions are exact only while no partial product underflows or
+// overflows, so any finite input would still need a range reduction with
+// its own proofs; mpq has no range and no proof beyond the algebra above,
+// and it runs only for the few tests the filter leaves (its ~1-3 us does
+// not show in the mean). Thread-local scratch: no allocation once warm.
+//
+// Fallback counters (`fallbacks()`): how many tests took stage 2 and stage
+// 3, for the audit's per-family rates (exact_method_audit_test prints them).
+// Measured (2-core shared machine; renderer/methods/README.md has the
+// table): `rayaudit audit --methods exact --rays 1000000` 0 in every error
+// column, float and double (t at most 1 ulp from the oracle's); kernel
+// bench (hit=50, back=50, nocull) 1.18x watertight's ns per test in float,
+// 1.86x in double (the x87 stage); crack maps 0 leaks, 0 false pixels.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <type_traits>
+
+#include "../hit.h"
+#include "../ray.h"
+
+namespace ra::exact {
+
+// Tests (all threads, since the start) that went past the double filter:
+// counted with relaxed atomics on those paths only, so the filter's own
+// path pays nothing.
+struct Fallbacks {
+  std::uint64_t extended = 0;  // double inputs: signs redone in long double, or t in double-word
+  std::uint64_t exact = 0;     // decided by GMP
+};
+Fallbacks fallbacks();
+void count_extended();
+void count_exact();
+
+// Stage 3: the whole test in exact rational arithmetic (exact.cpp).
+template <class T>
+std::optional<TriangleHit<T>> hit_exact(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                        bool cull);
+extern template std::optional<TriangleHit<float>> hit_exact(const Ray<float>&, const Vec3<float>&, const Vec3<float>&,
+                                                            const Vec3<float>&, bool);
+extern template std::optional<TriangleHit<double>> hit_exact(const Ray<double>&, const Vec3<double>&,
+                                                             const Vec3<double>&, const Vec3<double>&, bool);
+
+namespace detail {
+
+// The unit roundoff u of C (half the machine epsilon): 2^-53, 2^-64.
+template <class C>
+constexpr C unit_roundoff() {
+  return std::numeric_limits<C>::epsilon() / C(2);
+}
+
+template <class C>
+inline C max3(C x, C y, C z) {
+  return std::max(x, std::max(y, z));
+}
+
+// The filter's verdict on the signs of U, V, W.
+enum class Signs { miss, inside, undecided };
+
+// Stage 1/2: signs of U, V, W in compute type C, with the bound of the
+// header: err = 16 u s_d m_p m_q + tau. `limit`: the largest s_d and m
+// allowed (range guard; infinity where C is range-safe for T). U, V, W
+// and s (their common sign: +1 det > 0, -1 det < 0) are set for `inside`.
+template <class C, class T>
+[[gnu::always_inline]] inline Signs signs(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                          C limit, C tau, C& U, C& V, C& W, int& s) {
+  const C ox = C(r.o.x), oy = C(r.o.y), oz = C(r.o.z);
+  const C dx = C(r.d.x), dy = C(r.d.y), dz = C(r.d.z);
+  const C ax = C(a.x) - ox, ay = C(a.y) - oy, az = C(a.z) - oz;
+  const C bx = C(b.x) - ox, by = C(b.y) - oy, bz = C(b.z) - oz;
+  const C cx = C(c.x) - ox, cy = C(c.y) - oy, cz = C(c.z) - oz;
+  // U = d . (B' x C'), V = d . (C' x A'), W = d . (A' x B')
+  U = dx * (by * cz - bz * cy) + dy * (bz * cx - bx * cz) + dz * (bx * cy - by * cx);
+  V = dx * (cy * az - cz * ay) + dy * (cz * ax - cx * az) + dz * (cx * ay - cy * ax);
+  W = dx * (ay * bz - az * by) + dy * (az * bx - ax * bz) + dz * (ax * by - ay * bx);
+  const C sd = std::abs(dx) + std::abs(dy) + std::abs(dz);
+  const C ma = max3(std::abs(ax), std::abs(ay), std::abs(az));
+  const C mb = max3(std::abs(bx), std::abs(by), std::abs(bz));
+  const C mc = max3(std::abs(cx), std::abs(cy), std::abs(cz));
+  // Range guard (also false for NaN: then nothing is certified below).
+  if (!(max3(ma, mb, mc) <= limit && sd <= limit)) return Signs::undecided;
+  constexpr C k = C(16) * unit_roundoff<C>();
+  const C ksd = k * sd;
+  const C eU = ksd * mb * mc + tau, eV = ksd * mc * ma + tau, eW = ksd * ma * mb + tau;
+  const bool pu = U > eU, nu = U<-eU, pv = V> eV, nv = V<-eV, pw = W> eW, nw = W < -eW;
+  if ((pu | pv | pw) & (nu | nv | nw)) return Signs::miss;  // two certified opposite signs
+  if (pu & pv & pw) return s = 1, Signs::inside;
+  if (nu & nv & nw) return s = -1, Signs::inside;
+  return Signs::undecided;
+}
+
+// What the distance stage settled.
+enum class Dist { out, in, undecided };
+
+// The triangle's part of stage 1b, the same for every ray (the prepared
+// form stores it): the normal n = e1 x e2 in C from edges rounded once in
+// C, and the permanents Pn_i = |e1_j e2_k| + |e1_k e2_j| in double (SSE,
+// cheaper than x87 where C is long double): their factors are differences
+// rounded once (relative error <= 2^-53), then <= 5 roundings: within
+// (1 + 2^-50) of the permanents of exact values (the 1 + 2^-48 below).
+// Double inputs: the permanents are sound only without underflow or
+// overflow, so every factor must be 0 or within [2^-300, 2^300] (float
+// inputs always are, as stage 1's range note says); otherwise pn[0] is NaN
+// and stage 1b never decides.
+template <class C>
+struct Edges {
+  C n[3];
+  double pn[3];
+};
+inline bool tame(double x) { return x == 0 || (std::abs(x) >= 0x1p-300 && std::abs(x) <= 0x1p300); }
+template <class C, class T>
+[[gnu::always_inline]] inline Edges<C> edges(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
+  const C ax = C(a.x), ay = C(a.y), az = C(a.z);
+  const C e1x = C(b.x) - ax, e1y = C(b.y) - ay, e1z = C(b.z) - az;
+  const C e2x = C(c.x) - ax, e2y = C(c.y) - ay, e2z = C(c.z) - az;
+  Edges<C> e;
+  e.n[0] = e1y * e2z - e1z * e2y, e.n[1] = e1z * e2x - e1x * e2z, e.n[2] = e1x * e2y - e1y * e2x;
+  const double fe1x = double(b.x) - double(a.x), fe1y = double(b.y) - double(a.y), fe1z = double(b.z) - double(a.z);
+  const double fe2x = double(c.x) - double(a.x), fe2y = double(c.y) - double(a.y), fe2z = double(c.z) - double(a.z);
+  e.pn[0] = std::abs(fe1y * fe2z) + std::abs(fe1z * fe2y);
+  e.pn[1] = std::abs(fe1z * fe2x) + std::abs(fe1x * fe2z);
+  e.pn[2] = std::abs(fe1x * fe2y) + std::abs(fe1y * fe2x);
+  if constexpr (sizeof(T) == sizeof(double))
+    if (!(tame(fe1x) && tame(fe1y) && tame(fe1z) && tame(fe2x) && tame(fe2y) && tame(fe2z)))
+      e.pn[0] = std::numeric_limits<double>::quiet_NaN();
+  return e;
+}
+
+// Stage 1b: t = (n . A') / (n . d) in C with its enclosure (header); `out`
+// when the window is certainly missed, `in` with t_out (when need_t)
+// correctly or faithfully rounded to T when it is certainly met.
+template <class C, class T>
+[[gnu::always_inline]] inline Dist enclose_t(const Ray<T>& r, const Vec3<T>& a, const Edges<C>& e, bool need_t,
+                                             T& t_out) {
+  const C qx = C(a.x) - C(r.o.x), qy = C(a.y) - C(r.o.y), qz = C(a.z) - C(r.o.z);
+  const C N = e.n[0] * qx + e.n[1] * qy + e.n[2] * qz;
+  const C D = e.n[0] * C(r.d.x) + e.n[1] * C(r.d.y) + e.n[2] * C(r.d.z);
+  const double fqx = double(a.x) - double(r.o.x), fqy = double(a.y) - double(r.o.y), fqz = double(a.z) - double(r.o.z);
+  double PN = e.pn[0] * std::abs(fqx) + e.pn[1] * std::abs(fqy) + e.pn[2] * std::abs(fqz);
+  const double PD =
+      e.pn[0] * std::abs(double(r.d.x)) + e.pn[1] * std::abs(double(r.d.y)) + e.pn[2] * std::abs(double(r.d.z));
+  if constexpr (sizeof(T) == sizeof(double))
+    if (!(tame(fqx) && tame(fqy) && tame(fqz) && tame(r.d.x) && tame(r.d.y) && tame(r.d.z)))
+      PN = std::numeric_limits<double>::quiet_NaN();
+  // The bounds and the enclosure's relative width in double (one SSE
+  // division, beside the x87 one where C is long double): |N~|, |D~|
+  // rounded to double lose 2^-53 relative, the width's 7 roundings 2^-50,
+  // covered by the factors 1 + 2^-40.
+  constexpr C u = unit_roundoff<C>();
+  constexpr double k = double(16 * u) * (1 + 0x1p-48);
+  const double eN = k * PN, eD = k * PD;
+  const double aN = double(std::abs(N)), aD = double(std::abs(D));
+  if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD))
+    return Dist::undecided;  // t near 0, grazing, untamed (NaN)
+  const C t = N / D;
+  const double rel = (eN * aD + eD * aN) / (aN * aD) * (2 * (1 + 0x1p-40));
+  const C w = std::abs(t) * (C(rel) + C(16) * u);
+  const C lo = t - w, hi = t + w;
+  const C tlo = std::max(C(r.tmin), C(0)), thi = C(r.tmax);
+  if (hi < tlo || lo > thi) return Dist::out;
+  if (!(lo >= tlo && hi <= thi)) return Dist::undecided;  // on the window's edge (or a NaN window)
+  if (need_t) {
+    // Correctly rounded when the whole enclosure rounds to one T; else
+    // faithful when it lies strictly between the neighbours of T(t~): t is
+    // then within 1 ulp of the T returned, on no far side of a neighbour.
+    const T q = T(t);
+    if (T(lo) != T(hi) &&
+        !(std::isfinite(q) && lo > C(std::nextafter(q, T(-INFINITY))) && hi < C(std::nextafter(q, T(INFINITY)))))
+      return Dist::undecided;
+    t_out = q;
+  }
+  return Dist::in;
+}
+
+// Stage 2b (exact.cpp), double inputs: t in double-word arithmetic where
+// the long double enclosure was too wide to round; `in` only with t
+// correctly rounded.
+Dist t_double_word(const Ray<double>& r, const Vec3<double>& a, const Vec3<double>& b, const Vec3<double>& c,
+                   double& t_out);
+
+// The barycentrics from the certified Plücker values, clamped to [0, 1].
+template <class C, class T>
+[[gnu::always_inline]] inline TriangleHit<T> finish(T t, C U, C V, C W) {
+  const C inv = C(1) / (U + V + W);
+  const C b1 = std::min(std::max(V * inv, C(0)), C(1)), b2 = std::min(std::max(W * inv, C(0)), C(1));
+  return TriangleHit<T>{t, T(b1), T(b2)};
+}
+
+// The compute type of stage 1b: double for float inputs, long double for double.
+template <class T>
+using TCompute = std::conditional_t<sizeof(T) == sizeof(float), double, long double>;
+
+// The test; need_t = false for any-hit (the verdict only). `pre`: the
+// triangle's stage 1b terms if prepared (the same values edges() gives).
+template <class T>
+[[gnu::always_inline]] inline std::optional<TriangleHit<T>> test(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
+                                                                 const Vec3<T>& c, const Edges<TCompute<T>>* pre,
+                                                                 bool cull, bool need_t) {
+  constexpr bool kFloat = sizeof(T) == sizeof(float);
+  using C = TCompute<T>;
+  // Double inputs: the double filter's range guard and underflow term.
+  constexpr double kLimit = kFloat ? std::numeric_limits<double>::infinity() : 0x1p330;
+  constexpr double kTau = kFloat ? 0.0 : 0x1p-736;
+  double U, V, W;
+  int s = 0;
+  const Signs sg = signs<double>(r, a, b, c, kLimit, kTau, U, V, W, s);
+  if (sg == Signs::miss) return std::nullopt;
+  if (sg == Signs::inside) {
+    if (cull && s > 0) return std::nullopt;
+    T t{};
+    Dist ds = pre ? enclose_t<C>(r, a, *pre, need_t, t) : enclose_t<C>(r, a, edges<C>(a, b, c), need_t, t);
+    if constexpr (!kFloat)
+      if (ds == Dist::undecided) count_extended(), ds = t_double_word(r, a, b, c, t);
+    if (ds == Dist::out) return std::nullopt;
+    if (ds == Dist::in) return finish<double, T>(t, U, V, W);
+    count_exact();
+    return hit_exact(r, a, b, c, cull);
+  }
+  if constexpr (!kFloat) {
+    count_extended();
+    long double Ul, Vl, Wl;
+    const Signs sl = signs<long double>(r, a, b, c, std::numeric_limits<long double>::infinity(), 0.0L, Ul, Vl, Wl, s);
+    if (sl == Signs::miss) return std::nullopt;
+    if (sl == Signs::inside) {
+      if (cull && s > 0) return std::nullopt;
+      T t{};
+      Dist ds = enclose_t<C>(r, a, pre ? *pre : edges<C>(a, b, c), need_t, t);
+      if (ds == Dist::undecided) ds = t_double_word(r, a, b, c, t);
+      if (ds == Dist::out) return std::nullopt;
+      if (ds == Dist::in) return finish<long double, T>(t, Ul, Vl, Wl);
+    }
+  }
+  count_exact();
+  return hit_exact(r, a, b, c, cull);
+}
+
+// The prepared form: the vertices and the triangle's stage 1b terms.
+template <class T>
+struct Prepared {
+  Vec3<T> a, b, c;
+  Edges<TCompute<T>> e;
+};
+template <class T>
+Prepared<T> prepare(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
+  return {a, b, c, edges<TCompute<T>>(a, b, c)};
+}
+
+}  // namespace detail
+
+template <class T>
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
+  return detail::test(r, a, b, c, nullptr, cull, true);
+}
+
+template <class T>
+bool any(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
+  return detail::test(r, a, b, c, nullptr, cull, false).has_value();
+}
+
+// The same from the prepared form (bit for bit the same answers).
+template <class T>
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const detail::Prepared<T>& p, bool cull) {
+  return detail::test(r, p.a, p.b, p.c, &p.e, cull, true);
+}
+template <class T>
+bool any(const Ray<T>& r, const detail::Prepared<T>& p, bool cull) {
+  return detail::test(r, p.a, p.b, p.c, &p.e, cull, false).has_value();
+}
+
+}  // namespace ra::exact
