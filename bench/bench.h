@@ -67,12 +67,12 @@ void heap_reset_peak();
 
 // ---- The mesh ladder (../shared/CORPUS.md, scenes/corpus/) ----
 struct Rung {
-  std::string name;        // in benchmark names: box, teapot, ...
-  std::string scene;       // scenes/corpus/NAME.json
-  std::string obj;         // corpus/ladder/FILE.obj
-  std::size_t triangles;   // checked when loaded
-  bool closed;             // culling applies (cull_unsafe_reason is empty)
-  bool quick;              // part of --quick
+  std::string name;       // in benchmark names: box, teapot, ...
+  std::string scene;      // scenes/corpus/NAME.json
+  std::string obj;        // corpus/ladder/FILE.obj
+  std::size_t triangles;  // checked when loaded
+  bool closed;            // culling applies (cull_unsafe_reason is empty)
+  bool quick;             // part of --quick
 };
 const std::vector<Rung>& ladder();
 const Rung* find_rung(const std::string& name);

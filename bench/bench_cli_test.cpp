@@ -92,10 +92,10 @@ TEST(BenchCli, QuickSubsetHasEveryGroupNamesAndCounters) {
   // Exactly the rows asked for: 8 + 2 kernel, 3 accels x 2 culls x 2 ray kinds (the box is closed).
   EXPECT_EQ(groups["kernel"], 10);
   EXPECT_EQ(groups["scene"], 12);
-  for (const char* p : {"peer/embree/bunny/primary/default/threads=1", "peer/embree/bunny/shadow/default/threads=1",
-                        "peer/embree/bunny/build/default/threads=1", "peer/cgal/bunny/primary/threads=1",
-                        "peer/cgal/bunny/shadow/threads=1", "peer/tinyobjloader/bunny_glmark2",
-                        "peer/pov/bunny/threads=1"})
+  for (const char* p :
+       {"peer/embree/bunny/primary/default/threads=1", "peer/embree/bunny/shadow/default/threads=1",
+        "peer/embree/bunny/build/default/threads=1", "peer/cgal/bunny/primary/threads=1",
+        "peer/cgal/bunny/shadow/threads=1", "peer/tinyobjloader/bunny_glmark2", "peer/pov/bunny/threads=1"})
     EXPECT_TRUE(rows.count(p)) << p;
 
   // Culling changes the answer where rays meet back faces, not elsewhere.
@@ -153,7 +153,8 @@ TEST(BenchCli, UnknownFilterGroupIsRefused) {
 }
 
 TEST(BenchCli, UnwritableJsonIsRefused) {
-  const auto r = run_rayaudit("bench --quick --json /nonexistent-dir/b.json --filter kernel/moller/float/cull/hit=0/back=0");
+  const auto r =
+      run_rayaudit("bench --quick --json /nonexistent-dir/b.json --filter kernel/moller/float/cull/hit=0/back=0");
   EXPECT_EQ(r.code, 2) << r.all;
   EXPECT_EQ(lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("/nonexistent-dir/b.json"), std::string::npos) << r.err;
@@ -163,8 +164,11 @@ TEST(BenchCli, UnwritableJsonIsRefused) {
 TEST(BenchCli, MissingCorpusFileIsNamed) {
   const fs::path empty = fs::temp_directory_path() / ("rayaudit-bench-empty-cache-" + std::to_string(::getpid()));
   fs::create_directories(empty);
-  expect_refused("--filter scene/box/", (empty / "corpus/ladder/box.obj").string() + ": missing from the mesh corpus: "
-                 "ci/fetch-corpus.sh fetches it", "RAYAUDIT_CACHE=" + empty.string());
+  expect_refused("--filter scene/box/",
+                 (empty / "corpus/ladder/box.obj").string() +
+                     ": missing from the mesh corpus: "
+                     "ci/fetch-corpus.sh fetches it",
+                 "RAYAUDIT_CACHE=" + empty.string());
   fs::remove_all(empty);
 }
 
@@ -191,8 +195,9 @@ TEST(BenchCli, MissingPovRayIsAnError) {
 // Benchmark, and a ConsoleReporter made by hand colours unless told not to.
 // --benchmark_color=true still asks for them.
 TEST(BenchCli, NoColourEscapesUnlessOnATerminalOrAsked) {
-  const std::string row = "--filter '^kernel/plane/double/nocull/hit=50/back=0$' --benchmark_repetitions=1 "
-                          "--benchmark_min_time=0.01";
+  const std::string row =
+      "--filter '^kernel/plane/double/nocull/hit=50/back=0$' --benchmark_repetitions=1 "
+      "--benchmark_min_time=0.01";
   auto r = run_rayaudit("bench " + row, "TERM=xterm-256color");
   ASSERT_EQ(r.code, 0) << r.all;
   EXPECT_NE(r.out.find("kernel/plane/double"), std::string::npos) << r.out;
@@ -284,8 +289,8 @@ TEST(BenchCli, FullDiskKeepsThePreviousJson) {
   if (!disk.ok()) GTEST_SKIP() << disk.why_not();
   const fs::path out = disk.dir() / "b.json";
   std::ofstream(out) << "PRECIOUS\n";
-  const auto r = run_rayaudit("bench --filter 'kernel/moller/(float|double)/' --benchmark_repetitions=1 --json " +
-                              out.string());
+  const auto r =
+      run_rayaudit("bench --filter 'kernel/moller/(float|double)/' --benchmark_repetitions=1 --json " + out.string());
   EXPECT_EQ(r.code, 2) << r.all;
   EXPECT_NE(r.err.find(out.string() + ": cannot write: "), std::string::npos) << r.err;
   std::ifstream in(out);

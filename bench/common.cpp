@@ -44,14 +44,13 @@ benchmark::internal::Benchmark* add(const std::string& name, std::vector<fs::pat
                                     std::function<void(benchmark::State&)> fn) {
   registered().push_back({name, std::move(needs)});
   // An exception (a peer failing, a file gone) fails the row, not the run.
-  return benchmark::RegisterBenchmark(name.c_str(),
-                                      [fn](benchmark::State& s) {
-                                        try {
-                                          fn(s);
-                                        } catch (const std::exception& e) {
-                                          s.SkipWithError(e.what());
-                                        }
-                                      });
+  return benchmark::RegisterBenchmark(name.c_str(), [fn](benchmark::State& s) {
+    try {
+      fn(s);
+    } catch (const std::exception& e) {
+      s.SkipWithError(e.what());
+    }
+  });
 }
 
 namespace {

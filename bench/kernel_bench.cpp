@@ -196,9 +196,8 @@ void time_batch(benchmark::State& state, const Batch<T>& bt, bool cull, bool all
     wrong += got != want;
   }
   if (!allow_wrong && wrong > kPairs / 200) {
-    state.SkipWithError((std::to_string(wrong) + " of " + std::to_string(kPairs) +
-                         " answers differ from the batch's design")
-                            .c_str());
+    state.SkipWithError(
+        (std::to_string(wrong) + " of " + std::to_string(kPairs) + " answers differ from the batch's design").c_str());
     return;
   }
   // The thread's CPU time: steadier than the wall clock on a shared machine.
@@ -232,16 +231,14 @@ template <class T>
 void bm_sphere(benchmark::State& state, const ra::Method* m, int hit_pct, int back_pct) {
   const Batch<T>& bt = batch<T>(ra::Kind::sphere, hit_pct, back_pct);
   const auto& k = m->sphere<T>();
-  time_batch(state, bt, false, m->wrong_on_purpose,
-             [&](int i) { return t_of(k.hit(bt.rays[i], bt.a[i], bt.b[i].x)); });
+  time_batch(state, bt, false, m->wrong_on_purpose, [&](int i) { return t_of(k.hit(bt.rays[i], bt.a[i], bt.b[i].x)); });
 }
 
 template <class T>
 void bm_plane(benchmark::State& state, const ra::Method* m, int hit_pct, int back_pct) {
   const Batch<T>& bt = batch<T>(ra::Kind::plane, hit_pct, back_pct);
   const auto& k = m->plane<T>();
-  time_batch(state, bt, false, m->wrong_on_purpose,
-             [&](int i) { return t_of(k.hit(bt.rays[i], bt.a[i], bt.b[i].x)); });
+  time_batch(state, bt, false, m->wrong_on_purpose, [&](int i) { return t_of(k.hit(bt.rays[i], bt.a[i], bt.b[i].x)); });
 }
 
 }  // namespace
@@ -249,8 +246,8 @@ void bm_plane(benchmark::State& state, const ra::Method* m, int hit_pct, int bac
 void register_kernel() {
   for (const ra::Method& m : ra::methods()) {
     // Culling is a triangle option; spheres and planes have one row.
-    const std::vector<bool> culls = m.kind == ra::Kind::triangle ? std::vector<bool>{false, true}
-                                                                 : std::vector<bool>{false};
+    const std::vector<bool> culls =
+        m.kind == ra::Kind::triangle ? std::vector<bool>{false, true} : std::vector<bool>{false};
     for (const char* prec : {"float", "double"})
       for (bool cull : culls)
         for (int p : kHitRates)

@@ -97,8 +97,8 @@ struct Args {
   int threads = 0;
   std::string filter;
   bool has_filter = false;
-  int rounds = 0;  // --benchmark_repetitions (0: the mode's)
-  int runs = 1;    // --runs: separate processes, one after another
+  int rounds = 0;                        // --benchmark_repetitions (0: the mode's)
+  int runs = 1;                          // --runs: separate processes, one after another
   std::vector<std::string> passthrough;  // --benchmark_*
 };
 
@@ -121,12 +121,14 @@ bool option(int argc, char** argv, int& i, const char* name, std::string& value)
 // count: "vector::reserve") on a bad value. The bounds keep a
 // run finite: at most 1000 repetitions, at most 60 s a row.
 bool gb_bool(const std::string& v) {
-  static const std::set<std::string> ok{"", "true", "false", "yes", "no", "1", "0", "t", "f", "y", "n",
-                                        "True", "False", "TRUE", "FALSE", "Yes", "No"};
+  static const std::set<std::string> ok{"",  "true", "false", "yes",   "no",   "1",     "0",   "t", "f",
+                                        "y", "n",    "True",  "False", "TRUE", "FALSE", "Yes", "No"};
   return ok.count(v) != 0;
 }
-bool gb_true(const std::string& v) { return v.empty() || v == "true" || v == "yes" || v == "1" || v == "t" ||
-                                            v == "y" || v == "True" || v == "TRUE" || v == "Yes"; }
+bool gb_true(const std::string& v) {
+  return v.empty() || v == "true" || v == "yes" || v == "1" || v == "t" || v == "y" || v == "True" || v == "TRUE" ||
+         v == "Yes";
+}
 
 bool whole_number(const std::string& v, long lo, long hi) {
   char* end = nullptr;
@@ -168,9 +170,10 @@ void check_benchmark_flag(const std::string& arg) {
   } else if (name == "--benchmark_perf_counters" || name == "--benchmark_context") {
     if (!has_value || v.empty()) refuse("needs a value");
   } else {
-    refuse("is not a Google Benchmark flag rayaudit bench passes on (repetitions, min_time, min_warmup_time, "
-           "list_tests, display_aggregates_only, report_aggregates_only, enable_random_interleaving, "
-           "counters_tabular, format, color, time_unit, perf_counters, context)");
+    refuse(
+        "is not a Google Benchmark flag rayaudit bench passes on (repetitions, min_time, min_warmup_time, "
+        "list_tests, display_aggregates_only, report_aggregates_only, enable_random_interleaving, "
+        "counters_tabular, format, color, time_unit, perf_counters, context)");
   }
 }
 
@@ -205,15 +208,18 @@ Args parse_args(int argc, char** argv) {
       a.filter = v;
       a.has_filter = true;
     } else if (option(argc, argv, i, "--runs", v)) {
-      if (!whole_number(v, 1, 20)) throw ra::InputError("--runs: must be a whole number from 1 to 20, got \"" + v + "\"");
+      if (!whole_number(v, 1, 20))
+        throw ra::InputError("--runs: must be a whole number from 1 to 20, got \"" + v + "\"");
       a.runs = int(std::strtol(v.c_str(), nullptr, 10));
     } else if (arg.rfind("--benchmark_out", 0) == 0 || arg.rfind("--benchmark_filter", 0) == 0) {
       throw ra::InputError(arg.substr(0, arg.find('=')) + ": use --json OUT and --filter REGEX instead");
     } else if (arg.rfind("--benchmark_", 0) == 0) {
       check_benchmark_flag(arg);
       // Repetitions are run as rounds here (each row once per round).
-      if (arg.rfind("--benchmark_repetitions=", 0) == 0) a.rounds = int(std::strtol(arg.c_str() + 24, nullptr, 10));
-      else a.passthrough.push_back(arg);
+      if (arg.rfind("--benchmark_repetitions=", 0) == 0)
+        a.rounds = int(std::strtol(arg.c_str() + 24, nullptr, 10));
+      else
+        a.passthrough.push_back(arg);
     } else {
       throw ra::InputError("rayaudit bench: unknown argument \"" + arg +
                            "\" (--quick, --json OUT, --threads N, --filter REGEX, --runs N, --benchmark_*)");
@@ -263,8 +269,8 @@ void check_selection(const Args& a) {
       throw ra::InputError("--filter: unknown group \"" + g + "\" (groups: " + kGroups + ")");
   }
   if (selected == 0)
-    throw ra::InputError("--filter: \"" + a.filter + "\" selects no benchmark" +
-                         (a.quick ? " of --quick" : "") + " (groups: " + kGroups + ")");
+    throw ra::InputError("--filter: \"" + a.filter + "\" selects no benchmark" + (a.quick ? " of --quick" : "") +
+                         " (groups: " + kGroups + ")");
   for (const fs::path& p : needs) {
     std::error_code ec;
     if (!fs::is_regular_file(p, ec))
@@ -346,7 +352,6 @@ void register_all() {
   rb::register_oracle();
 }
 
-
 std::string self_exe(const char* argv0) {
   std::error_code ec;
   const fs::path p = fs::read_symlink("/proc/self/exe", ec);
@@ -369,7 +374,8 @@ int run_processes(const Args& a, const rb::Mode& mode, const char* argv0) {
   rb::Measured m;
   for (int i = 0; i < a.runs; ++i) {
     const fs::path out = fs::path(tmpl) / ("run-" + std::to_string(i) + ".json");
-    std::vector<std::string> args{exe, "--json=" + out.string(), "--benchmark_repetitions=" + std::to_string(mode.rounds)};
+    std::vector<std::string> args{exe, "--json=" + out.string(),
+                                  "--benchmark_repetitions=" + std::to_string(mode.rounds)};
     if (a.quick) args.push_back("--quick");
     if (a.threads > 0) args.push_back("--threads=" + std::to_string(a.threads));
     if (a.has_filter) args.push_back("--filter=" + a.filter);
@@ -389,7 +395,8 @@ int run_processes(const Args& a, const rb::Mode& mode, const char* argv0) {
     int status = 0;
     waitpid(pid, &status, 0);
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      std::fprintf(stderr, "rayaudit bench: run %d of %d failed%s\n", i + 1, a.runs, a.json.empty() ? "" : "; nothing written");
+      std::fprintf(stderr, "rayaudit bench: run %d of %d failed%s\n", i + 1, a.runs,
+                   a.json.empty() ? "" : "; nothing written");
       return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
     }
     std::ifstream in(out);

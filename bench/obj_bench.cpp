@@ -57,8 +57,8 @@ Parsed parse_tiny(const fs::path& file) {
   return measure([&] {
     auto r = std::make_unique<Tiny>();
     std::string warn, err;
-    if (!tinyobj::LoadObj(&r->attrib, &r->shapes, &r->materials, &warn, &err, file.c_str(),
-                          file.parent_path().c_str(), true))
+    if (!tinyobj::LoadObj(&r->attrib, &r->shapes, &r->materials, &warn, &err, file.c_str(), file.parent_path().c_str(),
+                          true))
       throw std::runtime_error("tinyobjloader: " + err);
     std::size_t n = 0;
     for (auto& s : r->shapes) n += s.mesh.num_face_vertices.size();
@@ -96,9 +96,9 @@ void bm_tiny(benchmark::State& state, const fs::path& file) {
     peak = std::max(peak, last.peak_bytes);
   }
   if (last.triangles != ours.triangles)
-    return state.SkipWithError(("tinyobjloader read " + std::to_string(last.triangles) + " triangles, ours " +
-                                std::to_string(ours.triangles))
-                                   .c_str());
+    return state.SkipWithError(
+        ("tinyobjloader read " + std::to_string(last.triangles) + " triangles, ours " + std::to_string(ours.triangles))
+            .c_str());
   state.SetBytesProcessed(long(state.iterations()) * long(fs::file_size(file)));
   state.counters["triangles"] = double(last.triangles);
   state.counters["peak_bytes_per_tri"] = double(peak) / double(last.triangles);
@@ -117,11 +117,12 @@ void register_obj() {
     const fs::path file = ladder_file(r->obj);
     const std::string stem = fs::path(r->obj).stem().string();
     for (int threads : {1, 0})
-      add("obj/" + stem + (threads == 1 ? "/serial" : "/parallel"), {file},
-          [=](benchmark::State& s) { bm_ours(s, file, threads); })
-          ->Unit(benchmark::kMillisecond);
-    add("peer/tinyobjloader/" + stem, {file}, [=](benchmark::State& s) { bm_tiny(s, file); })
-        ->Unit(benchmark::kMillisecond);
+      add("obj/" + stem + (threads == 1 ? "/serial" : "/parallel"), {file}, [=](benchmark::State& s) {
+        bm_ours(s, file, threads);
+      })->Unit(benchmark::kMillisecond);
+    add("peer/tinyobjloader/" + stem, {file}, [=](benchmark::State& s) {
+      bm_tiny(s, file);
+    })->Unit(benchmark::kMillisecond);
   }
 }
 

@@ -103,9 +103,8 @@ void BM_Triangle(benchmark::State& state, const Family* f, int threads) {
 
 void BM_Sphere(benchmark::State& state, const Family* f, int threads) {
   const std::vector<SphereCase>& c = sph_cases(*f);
-  run_oracle(state, c.size(), threads, [&](std::size_t i) {
-    benchmark::DoNotOptimize(ra::oracle::sphere(c[i].ray, c[i].center, c[i].radius));
-  });
+  run_oracle(state, c.size(), threads,
+             [&](std::size_t i) { benchmark::DoNotOptimize(ra::oracle::sphere(c[i].ray, c[i].center, c[i].radius)); });
 }
 
 }  // namespace

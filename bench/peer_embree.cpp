@@ -208,9 +208,9 @@ void bm_trace(benchmark::State& state, const Rung* rung, bool robust, bool shado
   state.counters["differ"] = double(differ);
   state.counters["rays"] = double(rays.size());
   state.counters["triangles"] = double(rung->triangles);
-  note("embree " + rung->name + " " + (shadow ? "shadow" : "primary") + " " + flag_name(robust) +
-       ": Embree hits " + std::to_string(hits) + ", ours " + std::to_string(ours_hits) + ", " +
-       std::to_string(differ) + " of " + std::to_string(rays.size()) + " rays differ");
+  note("embree " + rung->name + " " + (shadow ? "shadow" : "primary") + " " + flag_name(robust) + ": Embree hits " +
+       std::to_string(hits) + ", ours " + std::to_string(ours_hits) + ", " + std::to_string(differ) + " of " +
+       std::to_string(rays.size()) + " rays differ");
 }
 
 }  // namespace
@@ -223,8 +223,7 @@ void register_embree() {
     for (bool robust : {false, true})
       for (int t : thread_counts()) {
         const std::string tail = std::string("/") + flag_name(robust) + "/threads=" + std::to_string(t);
-        add("peer/embree/" + r->name + "/build" + tail, needs,
-            [=](benchmark::State& s) { bm_build(s, r, robust, t); });
+        add("peer/embree/" + r->name + "/build" + tail, needs, [=](benchmark::State& s) { bm_build(s, r, robust, t); });
         for (bool shadow : {false, true})
           add("peer/embree/" + r->name + (shadow ? "/shadow" : "/primary") + tail, needs,
               [=](benchmark::State& s) { bm_trace(s, r, robust, shadow, t); });

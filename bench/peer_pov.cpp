@@ -22,7 +22,6 @@
 namespace rb {
 namespace {
 
-
 std::string read_text(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream ss;
@@ -36,7 +35,8 @@ struct PovTime {
   double wall = -1, cpu = -1;
 };
 PovTime pov_time(const std::string& log, const std::string& what) {
-  const std::regex re(what + R"(:[^(\n]*\(([0-9.]+) seconds\)\s*\n\s*using \d+ thread\(s\) with ([0-9.]+) CPU-seconds)");
+  const std::regex re(what +
+                      R"(:[^(\n]*\(([0-9.]+) seconds\)\s*\n\s*using \d+ thread\(s\) with ([0-9.]+) CPU-seconds)");
   std::smatch m;
   PovTime t;
   if (std::regex_search(log, m, re)) {
@@ -79,13 +79,24 @@ void bm_pov(benchmark::State& state, const Rung* rung, int threads) {
   ini = std::regex_replace(ini, std::regex("Work_Threads=1"), "Work_Threads=" + std::to_string(threads));
   ra::write_text_atomically(work.path / "rayaudit.ini", ini);
   for (const auto& img : ex.images) ra::copy_pov_image(img.source, work.path / img.name);
-  const std::vector<std::string> pov_argv = {povray.string(), "rayaudit.ini", "+Iscene.pov", "+Oout.png",
-                                             "+W" + std::to_string(kWidth), "+H" + std::to_string(kHeight),
+  const std::vector<std::string> pov_argv = {povray.string(),
+                                             "rayaudit.ini",
+                                             "+Iscene.pov",
+                                             "+Oout.png",
+                                             "+W" + std::to_string(kWidth),
+                                             "+H" + std::to_string(kHeight),
                                              "+WT" + std::to_string(threads)};
-  const std::vector<std::string> ours_argv = {rayaudit_program().string(), "render",
-                                              rung_scene_file(*rung).string(), "-o", "ours.png", "--width",
-                                              std::to_string(kWidth), "--height", std::to_string(kHeight),
-                                              "--threads", std::to_string(threads)};
+  const std::vector<std::string> ours_argv = {rayaudit_program().string(),
+                                              "render",
+                                              rung_scene_file(*rung).string(),
+                                              "-o",
+                                              "ours.png",
+                                              "--width",
+                                              std::to_string(kWidth),
+                                              "--height",
+                                              std::to_string(kHeight),
+                                              "--threads",
+                                              std::to_string(threads)};
   double pov_parse = 0, pov_trace = 0, pov_trace_cpu = 0, pov_proc = 0;
   double ours_parse = 0, ours_trace = 0, ours_proc = 0;
   for (auto _ : state) {

@@ -59,8 +59,10 @@ json parse_gbench(const std::string& in) {
     const char c = in[i];
     if (str) {
       out += c;
-      if (c == '\\' && i + 1 < in.size()) out += in[++i];
-      else if (c == '"') str = false;
+      if (c == '\\' && i + 1 < in.size())
+        out += in[++i];
+      else if (c == '"')
+        str = false;
       continue;
     }
     if (c == '"') str = true;
@@ -99,16 +101,31 @@ double quantile(std::vector<double> v, double q) {
 
 json five(const std::vector<double>& v) {
   if (v.empty()) return nullptr;
-  return {{"median", median_of(v)}, {"q1", quantile(v, 0.25)}, {"q3", quantile(v, 0.75)},
-          {"min", *std::min_element(v.begin(), v.end())}, {"max", *std::max_element(v.begin(), v.end())}};
+  return {{"median", median_of(v)},
+          {"q1", quantile(v, 0.25)},
+          {"q3", quantile(v, 0.75)},
+          {"min", *std::min_element(v.begin(), v.end())},
+          {"max", *std::max_element(v.begin(), v.end())}};
 }
 
 // Google Benchmark's own keys of a run row; every other number is a counter.
 bool gb_key(const std::string& k) {
-  static const std::set<std::string> keys{
-      "name", "family_index", "per_family_instance_index", "run_name", "run_type", "repetitions",
-      "repetition_index", "threads", "iterations", "time_unit", "error_occurred", "error_message",
-      "aggregate_name", "aggregate_unit", "label", "skipped"};
+  static const std::set<std::string> keys{"name",
+                                          "family_index",
+                                          "per_family_instance_index",
+                                          "run_name",
+                                          "run_type",
+                                          "repetitions",
+                                          "repetition_index",
+                                          "threads",
+                                          "iterations",
+                                          "time_unit",
+                                          "error_occurred",
+                                          "error_message",
+                                          "aggregate_name",
+                                          "aggregate_unit",
+                                          "label",
+                                          "skipped"};
   return keys.count(k) || k.rfind("rayaudit_", 0) == 0;
 }
 
@@ -137,13 +154,22 @@ json machine() {
   bool hv = false;
   int cores = 0;
   while (std::getline(ci, line)) {
-    auto val = [&] { const auto p = line.find(':'); return p == std::string::npos ? std::string() : line.substr(p + 2); };
-    if (line.rfind("processor", 0) == 0) ++cores;
-    else if (model.empty() && line.rfind("model name", 0) == 0) model = val();
-    else if (family.empty() && line.rfind("cpu family", 0) == 0) family = val();
-    else if (cpu_model.empty() && line.rfind("model\t", 0) == 0) cpu_model = val();
-    else if (stepping.empty() && line.rfind("stepping", 0) == 0) stepping = val();
-    else if (line.rfind("flags", 0) == 0 && (" " + val() + " ").find(" hypervisor ") != std::string::npos) hv = true;
+    auto val = [&] {
+      const auto p = line.find(':');
+      return p == std::string::npos ? std::string() : line.substr(p + 2);
+    };
+    if (line.rfind("processor", 0) == 0)
+      ++cores;
+    else if (model.empty() && line.rfind("model name", 0) == 0)
+      model = val();
+    else if (family.empty() && line.rfind("cpu family", 0) == 0)
+      family = val();
+    else if (cpu_model.empty() && line.rfind("model\t", 0) == 0)
+      cpu_model = val();
+    else if (stepping.empty() && line.rfind("stepping", 0) == 0)
+      stepping = val();
+    else if (line.rfind("flags", 0) == 0 && (" " + val() + " ").find(" hypervisor ") != std::string::npos)
+      hv = true;
   }
   m["cpu_model"] = model;
   m["cpu_family_model_stepping"] = family + "/" + cpu_model + "/" + stepping;
@@ -208,8 +234,10 @@ std::vector<std::string> mark_slow(std::vector<Rep>& reps, const std::vector<Cal
     else if (m > kSlowFactor * fastest[k])
       why = std::string("its whole run was slow (") + (k ? "CPU" : "wall") + " clock)";
     r.row["rayaudit_slow_phase"] = !why.empty();
-    if (!why.empty()) r.row["rayaudit_slow_why"] = why;
-    else ++good[n];
+    if (!why.empty())
+      r.row["rayaudit_slow_why"] = why;
+    else
+      ++good[n];
   }
   std::vector<std::string> again;
   for (const auto& n : order)
@@ -231,7 +259,9 @@ void absorb(const json& child, int run, Measured& into) {
     into.reps.push_back(std::move(r));
   }
   for (const json& s : child.at("rayaudit").at("calibration").at("samples"))
-    into.cal.push_back({run, s.at("t_s").get<double>(), {s.at("us").get<double>(), s.at("cpu_us").get<double>()},
+    into.cal.push_back({run,
+                        s.at("t_s").get<double>(),
+                        {s.at("us").get<double>(), s.at("cpu_us").get<double>()},
                         s.value("after", "")});
 }
 
@@ -295,16 +325,22 @@ json assemble(const Measured& m, const Mode& mode) {
           for (double x : v) var += (x - mean) * (x - mean);
           const double sd = std::sqrt(var / double(v.size() - 1));
           const std::string s = agg;
-          const double val = s == "mean" ? mean : s == "median" ? median_of(v) : s == "stddev" ? sd
-                             : (mean != 0 ? sd / mean : std::nan(""));
+          const double val = s == "mean"     ? mean
+                             : s == "median" ? median_of(v)
+                             : s == "stddev" ? sd
+                                             : (mean != 0 ? sd / mean : std::nan(""));
           a[k] = std::isfinite(val) ? json(val) : json(nullptr);
         }
         benchmarks.push_back(a);
       }
     }
     const auto [metric, better] = metric_of(n);
-    json e = {{"name", n}, {"metric", metric}, {"better", better}, {"repetitions", int(ok.size())},
-              {"used", int(used.size())}, {"slow_repetitions", int(ok.size() - good.size())}};
+    json e = {{"name", n},
+              {"metric", metric},
+              {"better", better},
+              {"repetitions", int(ok.size())},
+              {"used", int(used.size())},
+              {"slow_repetitions", int(ok.size() - good.size())}};
     slow_reps += int(ok.size() - good.size());
     const bool had_retry = std::any_of(reps.begin(), reps.end(), [](const Rep* r) { return r->retry; });
     retried += had_retry;
@@ -316,8 +352,10 @@ json assemble(const Measured& m, const Mode& mode) {
     json per_run = json::array();
     std::map<int, std::vector<double>> run_vals;
     for (const Rep* r : used)
-      if (r->row.contains(metric) && r->row[metric].is_number()) run_vals[r->run].push_back(r->row[metric].get<double>());
-    for (const auto& [run, v] : run_vals) per_run.push_back({{"run", run}, {"median", median_of(v)}, {"n", int(v.size())}});
+      if (r->row.contains(metric) && r->row[metric].is_number())
+        run_vals[r->run].push_back(r->row[metric].get<double>());
+    for (const auto& [run, v] : run_vals)
+      per_run.push_back({{"run", run}, {"median", median_of(v)}, {"n", int(v.size())}});
     e["run_medians"] = per_run;
     std::string flag;
     if (int(good.size()) < mode.rounds * mode.runs && good.size() < ok.size())
@@ -349,7 +387,8 @@ json assemble(const Measured& m, const Mode& mode) {
   }
   json runs = json::array();
   for (const auto& [run, v] : cal_runs)
-    runs.push_back({{"run", run}, {"five", five(v)}, {"cpu_five", five(cal_cpu_runs[run])}, {"samples", int(v.size())}});
+    runs.push_back(
+        {{"run", run}, {"five", five(v)}, {"cpu_five", five(cal_cpu_runs[run])}, {"samples", int(v.size())}});
   const auto steal0 = g_steal_at_start;
   const auto steal1 = steal_and_total();
   out["rayaudit"] = {
@@ -359,14 +398,16 @@ json assemble(const Measured& m, const Mode& mode) {
       {"runs", mode.runs},
       {"min_time_s", mode.min_time},
       {"filter", mode.filter},
-      {"interleaving", "every selected row once per round, rounds one after another; with --runs, each run a "
-                       "separate process"},
+      {"interleaving",
+       "every selected row once per round, rounds one after another; with --runs, each run a "
+       "separate process"},
       {"machine", machine()},
-      {"steal_pct", steal1.second > steal0.second
-                        ? 100.0 * (steal1.first - steal0.first) / (steal1.second - steal0.second) : 0.0},
+      {"steal_pct",
+       steal1.second > steal0.second ? 100.0 * (steal1.first - steal0.first) / (steal1.second - steal0.second) : 0.0},
       {"calibration",
-       {{"workload", "2^18 steps of a dependent xorshift + sqrt chain, fastest of 3 timings on the wall clock (us) "
-                     "and on the thread's CPU clock (cpu_us)"},
+       {{"workload",
+         "2^18 steps of a dependent xorshift + sqrt chain, fastest of 3 timings on the wall clock (us) "
+         "and on the thread's CPU clock (cpu_us)"},
         {"unit", "us"},
         {"judged_by", "kernel/ rows (timed in thread CPU time) by cpu_us, every other row by us"},
         {"slow_factor", kSlowFactor},

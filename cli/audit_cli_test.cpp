@@ -69,7 +69,9 @@ TEST(AuditCli, ResultsDoNotDependOnThreads) {
 
 TEST(AuditCli, CasesJsonHasExactlyTheDocumentedShape) {
   const fs::path csv = tmp("cases.csv"), json = tmp("cases.json");
-  write(csv, kHeader + "0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n0x1p-1,0,1,0,0,-1,0,0,0,1,0,0,0,1,0\n5,5,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
+  write(csv, kHeader +
+                 "0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n0x1p-1,0,1,0,0,-1,0,0,0,1,0,0,0,1,0\n5,5,1,0,0,-1,0,0,0,1,0,0,"
+                 "0,1,0\n");
   const Result r = rayaudit("audit --cases " + csv.string() + " --json " + json.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(json));
@@ -123,7 +125,8 @@ TEST(AuditCli, MalformedCasesExitTwoWithFileLineAndWriteNothing) {
 
 TEST(AuditCli, ExportThenAuditAgreesOnEveryVerdict) {
   const fs::path csv = tmp("export.csv"), json = tmp("export.json");
-  const Result e = rayaudit("audit --export-cases " + csv.string() + " --families edge,vertex,near-miss,degenerate --rays 2000");
+  const Result e =
+      rayaudit("audit --export-cases " + csv.string() + " --families edge,vertex,near-miss,degenerate --rays 2000");
   ASSERT_EQ(e.code, 0) << e.err;
   const Result r = rayaudit("audit --methods moller --cases " + csv.string() + " --json " + json.string());
   ASSERT_EQ(r.code, 0) << r.err;
@@ -154,15 +157,17 @@ TEST(AuditCli, ExportThenAuditAgreesOnEveryVerdict) {
 TEST(AuditCli, OneUnwritableOutputMeansNoOutputAtAll) {
   const fs::path json = tmp("half.json");
   fs::remove(json);
-  const Result r = rayaudit("audit --methods moller --families random --rays 10 --csv /nonexistent/x.csv --json " +
-                            json.string());
+  const Result r =
+      rayaudit("audit --methods moller --families random --rays 10 --csv /nonexistent/x.csv --json " + json.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("/nonexistent/x.csv: output directory does not exist"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(json)) << "the JSON was written though the CSV could not be";
   // Both writable: both written, no temporary left behind.
   const fs::path csv = tmp("half.csv");
-  ASSERT_EQ(rayaudit("audit --methods moller --families random --rays 10 --csv " + csv.string() + " --json " +
-                     json.string()).code, 0);
+  ASSERT_EQ(
+      rayaudit("audit --methods moller --families random --rays 10 --csv " + csv.string() + " --json " + json.string())
+          .code,
+      0);
   EXPECT_TRUE(fs::exists(json) && fs::exists(csv));
   for (const auto& e : fs::directory_iterator(json.parent_path()))
     EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
@@ -222,8 +227,8 @@ TEST(AuditShards, TwoShardsMergedEqualTheUnshardedRunByteForByte) {
   EXPECT_LT(ta, 3 * tu / 4);
   EXPECT_EQ(ja["shard"]["k"], 1);
   EXPECT_EQ(ja["shard"]["n"], 2);
-  const Result mr = rayaudit("audit merge " + b.string() + " " + a.string() + " --json " + m.string() + " --csv " +
-                             mc.string());
+  const Result mr =
+      rayaudit("audit merge " + b.string() + " " + a.string() + " --json " + m.string() + " --csv " + mc.string());
   ASSERT_EQ(mr.code, 0) << mr.err;
   EXPECT_EQ(slurp(m), slurp(u));
   EXPECT_EQ(slurp(mc), slurp(uc));
@@ -238,11 +243,14 @@ TEST(AuditShards, MergingShardsOfDifferentRunsIsAnErrorNamingBothFiles) {
   ASSERT_EQ(rayaudit(run + " --shard 1/2 --json " + a.string()).code, 0);
   ASSERT_EQ(rayaudit(run + " --shard 2/2 --json " + b.string()).code, 0);
   ASSERT_EQ(rayaudit(run + " --shard 2/2 --seed 9 --json " + seed.string()).code, 0);
-  ASSERT_EQ(rayaudit("audit --methods moller --families random,edge --rays 2000 --shard 2/2 --json " + rays.string()).code, 0);
-  ASSERT_EQ(rayaudit("audit --methods cramer --families random,edge --rays 1000 --shard 2/2 --json " + meth.string()).code, 0);
+  ASSERT_EQ(
+      rayaudit("audit --methods moller --families random,edge --rays 2000 --shard 2/2 --json " + rays.string()).code,
+      0);
+  ASSERT_EQ(
+      rayaudit("audit --methods cramer --families random,edge --rays 1000 --shard 2/2 --json " + meth.string()).code,
+      0);
   ASSERT_EQ(rayaudit(run + " --json " + whole.string()).code, 0);
-  const std::pair<fs::path, std::string> bad[] = {
-      {seed, "seed"}, {rays, "rays per family"}, {meth, "methods"}};
+  const std::pair<fs::path, std::string> bad[] = {{seed, "seed"}, {rays, "rays per family"}, {meth, "methods"}};
   for (const auto& [other, what] : bad) {
     fs::remove(out);
     const Result r = rayaudit("audit merge " + a.string() + " " + other.string() + " --json " + out.string());
@@ -326,11 +334,13 @@ TEST(AuditShards, HostileShardsAreOneLineErrors) {
 // decides: rays through shared edges and vertices that both neighbours miss.
 TEST(AuditGrade, PythonMollerTrumboreLeaks) {
   const fs::path cases = tmp("py_cases.csv"), answers = tmp("py_mt.csv"), json = tmp("py_graded.json");
-  ASSERT_EQ(rayaudit("audit --export-cases " + cases.string() + " --families edge,vertex,closed-mesh --rays 6000").code, 0);
+  ASSERT_EQ(rayaudit("audit --export-cases " + cases.string() + " --families edge,vertex,closed-mesh --rays 6000").code,
+            0);
   const std::string script = std::string(RAYAUDIT_SOURCE_DIR) + "/examples/grade/moller_trumbore.py";
   ASSERT_EQ(std::system(("/usr/bin/python3 " + script + " " + cases.string() + " " + answers.string()).c_str()), 0)
       << "the example needs /usr/bin/python3 with numpy (ci/install-deps.sh)";
-  const Result r = rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string());
+  const Result r =
+      rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("py_mt/double"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(slurp(json));
@@ -349,9 +359,10 @@ TEST(AuditGrade, PythonMollerTrumboreLeaks) {
 
 TEST(AuditGrade, BadAnswersExitTwoWithFileLineAndWriteNothing) {
   const fs::path cases = tmp("g_cases.csv"), answers = tmp("g_answers.csv"), json = tmp("g.json");
-  write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
-               "a,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n"
-               "b,5,5,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
+  write(cases,
+        "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
+        "a,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n"
+        "b,5,5,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
   const std::pair<std::string, std::string> bad[] = {
       {"id,hit,t\na,true,1\n", cases.string() + ":3: case 'b' has no answer"},
       {"id,hit,t\na,true,1\nb,false,\na,true,1\n", answers.string() + ":4: duplicate id 'a'"},
@@ -363,7 +374,8 @@ TEST(AuditGrade, BadAnswersExitTwoWithFileLineAndWriteNothing) {
   for (const auto& [text, msg] : bad) {
     write(answers, text);
     fs::remove(json);
-    const Result r = rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string());
+    const Result r =
+        rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string());
     if (msg.empty()) {
       EXPECT_EQ(r.code, 0) << r.err;
       EXPECT_TRUE(fs::exists(json));
@@ -384,9 +396,10 @@ TEST(AuditGrade, BadAnswersExitTwoWithFileLineAndWriteNothing) {
 TEST(AuditGrade, NonFiniteTIsWrongAndFloatCasesAreRounded) {
   const fs::path cases = tmp("gn_cases.csv"), answers = tmp("gn_answers.csv"), json = tmp("gn.json"),
                  csv = tmp("gn.csv");
-  write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
-               "a,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n"
-               "h,0x1.0000000000001p-1,0x1p-1,-1,0,0,1,0,0,0,1,0,0,0,1,0\n");
+  write(cases,
+        "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\n"
+        "a,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n"
+        "h,0x1.0000000000001p-1,0x1p-1,-1,0,0,1,0,0,0,1,0,0,0,1,0\n");
   auto totals = [&](const std::string& extra) {
     fs::remove(json);
     const Result r = rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " +
@@ -423,7 +436,8 @@ TEST(AuditGrade, NonFiniteTIsWrongAndFloatCasesAreRounded) {
   // quotes it, so every row has the header's number of fields.
   const fs::path odd = tmp("my,ans\"wer.csv");
   fs::copy_file(answers, odd, fs::copy_options::overwrite_existing);
-  const Result r = rayaudit("audit --grade '" + odd.string() + "' --cases " + cases.string() + " --csv " + csv.string());
+  const Result r =
+      rayaudit("audit --grade '" + odd.string() + "' --cases " + cases.string() + " --csv " + csv.string());
   ASSERT_EQ(r.code, 0) << r.err;
   std::istringstream lines(slurp(csv));
   std::string header, row;
@@ -434,8 +448,10 @@ TEST(AuditGrade, NonFiniteTIsWrongAndFloatCasesAreRounded) {
   int fields = 1;
   bool quoted = false;
   for (char ch : row) {
-    if (ch == '"') quoted = !quoted;
-    else if (ch == ',' && !quoted) ++fields;
+    if (ch == '"')
+      quoted = !quoted;
+    else if (ch == ',' && !quoted)
+      ++fields;
   }
   EXPECT_EQ(fields, int(std::count(header.begin(), header.end(), ',')) + 1) << row;
 }
@@ -446,7 +462,8 @@ TEST(AuditGrade, NonFiniteTIsWrongAndFloatCasesAreRounded) {
 TEST(AuditGrade, AnswersEncodingAndNonFilesAreNamed) {
   const fs::path cases = tmp("ge_cases.csv"), answers = tmp("ge_answers.csv"), json = tmp("ge.json");
   write(cases, "id,ox,oy,oz,dx,dy,dz,ax,ay,az,bx,by,bz,cx,cy,cz\na,0.25,0.25,1,0,0,-1,0,0,0,1,0,0,0,1,0\n");
-  const std::string grade = "audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string();
+  const std::string grade =
+      "audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + json.string();
   write(answers, "\xEF\xBB\xBFid,hit,t\na,true,1\n");
   Result r = rayaudit(grade);
   EXPECT_EQ(r.code, 0) << r.err;
@@ -500,8 +517,7 @@ TEST(AuditCli, CasesMemoryDoesNotGrowWithRows) {
   auto make = [&](const fs::path& p, int rows) {
     std::ofstream out(p);
     out << kHeader;
-    for (int i = 0; i < rows; ++i)
-      out << 0.001 * (i % 997) << ",0.25,1,0,0,-1,0,0,0,1,0,0,0,1," << (i % 3) << "\n";
+    for (int i = 0; i < rows; ++i) out << 0.001 * (i % 997) << ",0.25,1,0,0,-1,0,0,0,1,0,0,0,1," << (i % 3) << "\n";
   };
   const fs::path small = tmp("rows20k.csv"), large = tmp("rows100k.csv"), json = tmp("rows.json");
   make(small, 20000);
@@ -521,8 +537,8 @@ TEST(AuditExportCli, ExportCasesTakesOnePrecision) {
   for (const char* list : {"float,double", "double,float"}) {
     const auto r = run_rayaudit("audit --export-cases " + out.string() + " --precision " + list + " --rays 10");
     EXPECT_EQ(r.code, 2) << r.all;
-    EXPECT_EQ(r.err, std::string("--precision: --export-cases takes one precision (float or double), got '") + list +
-                         "'\n");
+    EXPECT_EQ(r.err,
+              std::string("--precision: --export-cases takes one precision (float or double), got '") + list + "'\n");
     EXPECT_FALSE(fs::exists(out));
   }
   const auto ok = run_rayaudit("audit --export-cases " + out.string() + " --precision float --rays 10 --families edge");
@@ -535,8 +551,9 @@ TEST(AuditExportCli, ExportCasesTakesOnePrecision) {
 TEST(AuditExportCli, ExportCasesStreamsWithinAFixedAddressSpace) {
   RAYAUDIT_SKIP_IF_SANITIZED();
   const fs::path out = scratch("streamed.csv");
-  const auto r = run_rayaudit("audit --export-cases " + out.string() + " --rays 300000 --families random --precision double",
-                              "prlimit --as=200000000");
+  const auto r =
+      run_rayaudit("audit --export-cases " + out.string() + " --rays 300000 --families random --precision double",
+                   "prlimit --as=200000000");
   ASSERT_EQ(r.code, 0) << r.all;
   EXPECT_NE(r.out.find("wrote 300000 double cases"), std::string::npos) << r.out;
   std::ifstream in(out);
@@ -550,8 +567,10 @@ TEST(AuditExportCli, ExportCasesStreamsWithinAFixedAddressSpace) {
 // a hostile shard was held at ~30x its size (a bare std::bad_alloc).
 TEST(AuditShards, MergeRefusesImpossibleStatsUnknownKeysAndHugeShards) {
   const fs::path sh1 = scratch("sh1.json"), sh2 = scratch("sh2.json"), out = scratch("merged.json");
-  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 1/2 --json " + sh1.string()).code, 0);
-  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 2/2 --json " + sh2.string()).code, 0);
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 1/2 --json " + sh1.string()).code,
+            0);
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 100 --shard 2/2 --json " + sh2.string()).code,
+            0);
   const std::string text = slurp(sh1);
   auto variant = [&](const std::string& name, const std::string& from, const std::string& to) {
     return scratch_variant(text, name, from, to);
@@ -584,7 +603,8 @@ TEST(AuditShards, MergeRefusesImpossibleStatsUnknownKeysAndHugeShards) {
   std::ofstream(big) << text.substr(0, text.size() - 2) << std::string(9u << 20, ' ') << "}\n";
   const auto r = run_rayaudit("audit merge " + big.string() + " " + sh2.string() + " --json " + out.string());
   EXPECT_EQ(r.code, 2) << r.all;
-  EXPECT_EQ(r.err, big.string() + ": 9 MB is larger than a shard can be (at most 8 MB; a full audit's shard is about 1 MB)\n");
+  EXPECT_EQ(r.err,
+            big.string() + ": 9 MB is larger than a shard can be (at most 8 MB; a full audit's shard is about 1 MB)\n");
   EXPECT_FALSE(fs::exists(out));
   // The untouched shards still merge.
   EXPECT_EQ(run_rayaudit("audit merge " + sh1.string() + " " + sh2.string() + " --json " + out.string()).code, 0);

@@ -74,7 +74,8 @@ TEST(AuditGate, LosingTwentyGrazingHitsFailsTheBaselineAndTheJUnitSaysWhere) {
   const fs::path cases = tmp("cases.csv"), base = tmp("base.json"), junit = tmp("gate.xml");
   fs::create_directories(tmp("v1")), fs::create_directories(tmp("v2"));
   const fs::path v1 = tmp("v1") / "mine.csv", v2 = tmp("v2") / "mine.csv";  // one subject name: "mine"
-  auto r = run_rayaudit("audit --export-cases " + cases.string() + " --families random,grazing --rays 2000 "
+  auto r = run_rayaudit("audit --export-cases " + cases.string() +
+                        " --families random,grazing --rays 2000 "
                         "--precision float --seed 5");
   ASSERT_EQ(r.code, 0) << r.all;
   write_answers(cases, v1, "grazing", 0);
@@ -126,8 +127,9 @@ TEST(AuditGate, LosingTwentyGrazingHitsFailsTheBaselineAndTheJUnitSaysWhere) {
 
   // The same through `audit diff` of the two graded files.
   const fs::path worse = tmp("worse.json");
-  ASSERT_EQ(run_rayaudit("audit --grade " + v2.string() + " --cases " + cases.string() + " --json " + worse.string())
-                .code, 0);
+  ASSERT_EQ(
+      run_rayaudit("audit --grade " + v2.string() + " --cases " + cases.string() + " --json " + worse.string()).code,
+      0);
   r = run_rayaudit("audit diff " + base.string() + " " + worse.string());
   EXPECT_EQ(r.code, 1) << r.all;
   EXPECT_NE(r.out.find("grazing@"), std::string::npos) << r.out;
@@ -159,8 +161,8 @@ TEST(AuditGate, BaselinesOfOtherRaysAreRefusedInOneLine) {
   auto r = run_rayaudit("audit --methods moller --families grazing --rays 700 --baseline " + a.string());
   EXPECT_EQ(r.code, 0) << r.all;
   EXPECT_NE(r.out.find("0 figure(s) rose"), std::string::npos) << r.out;
-  const std::pair<std::string, std::string> refused[] = {
-      {"--rays 700 --seed 2", "seed"}, {"--rays 800", "rays per family"}};
+  const std::pair<std::string, std::string> refused[] = {{"--rays 700 --seed 2", "seed"},
+                                                         {"--rays 800", "rays per family"}};
   for (const auto& [opt, word] : refused) {
     r = run_rayaudit("audit --methods moller --families grazing " + opt + " --baseline " + a.string());
     EXPECT_EQ(r.code, 2) << opt;
@@ -173,8 +175,9 @@ TEST(AuditGate, BaselinesOfOtherRaysAreRefusedInOneLine) {
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(one_line(r.err)) << r.err;
   EXPECT_NE(r.err.find("families differ"), std::string::npos) << r.err;
-  ASSERT_EQ(run_rayaudit("audit --methods moller --families grazing --rays 700 --shard 1/2 --json " + shard.string())
-                .code, 0);
+  ASSERT_EQ(
+      run_rayaudit("audit --methods moller --families grazing --rays 700 --shard 1/2 --json " + shard.string()).code,
+      0);
   r = run_rayaudit("audit diff " + a.string() + " " + shard.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("merge the shards first"), std::string::npos) << r.err;
@@ -218,8 +221,9 @@ TEST(AuditGate, FamiliesThatCannotBeExportedAreRefusedByName) {
 // a stamp from another version: refused.
 TEST(AuditGate, FloatLookingAnswersNeedAPrecisionAndStampsAreChecked) {
   const fs::path cases = tmp("f_cases.csv"), plain = tmp("f_plain.csv"), answers = tmp("f_answers.csv");
-  ASSERT_EQ(run_rayaudit("audit --export-cases " + cases.string() + " --families random --rays 300 --precision float")
-                .code, 0);
+  ASSERT_EQ(
+      run_rayaudit("audit --export-cases " + cases.string() + " --families random --rays 300 --precision float").code,
+      0);
   write_answers(cases, answers, "random", 0, /*float_t=*/true);
   // The same cases without their stamp line.
   {

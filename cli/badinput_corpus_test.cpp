@@ -160,8 +160,11 @@ TEST_P(BadInput, Exits2WithOneLineNamingTheFileAndWritesNothing) {
   } else if (kind == "csv") {
     args = {"audit", "--cases", file.string(), "--json", (out / "out.json").string()};
   } else if (kind == "tolerance") {
-    args = {"compare", src + "/scenes/doc002-tetrahedron.json", "--tolerance", file.string(), "--json",
-            (out / "out.json").string(), "--width", "8", "--height", "8"};
+    args = {"compare",     src + "/scenes/doc002-tetrahedron.json",
+            "--tolerance", file.string(),
+            "--json",      (out / "out.json").string(),
+            "--width",     "8",
+            "--height",    "8"};
   } else if (kind == "golden") {
     fs::create_directories(work / "root" / "golden");
     fs::create_directories(work / "root" / "scenes");
@@ -170,8 +173,8 @@ TEST_P(BadInput, Exits2WithOneLineNamingTheFileAndWritesNothing) {
     args = {"golden", "check", "--root", (work / "root").string(), "--diff-dir", out.string()};
   } else if (kind == "texture") {
     std::ofstream(work / "scene.json") << R"({"objects": [{"mesh": ")" << src
-                                       << R"(/scenes/meshes/quad.obj", "material": {"texture": ")"
-                                       << file.string() << "\"}}]}\n";
+                                       << R"(/scenes/meshes/quad.obj", "material": {"texture": ")" << file.string()
+                                       << "\"}}]}\n";
     args = {"render", (work / "scene.json").string()};
     args.insert(args.end(), render_to.begin(), render_to.end());
   } else {

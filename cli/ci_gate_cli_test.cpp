@@ -29,7 +29,9 @@ TEST(CiFiles, YamlParsesAndCallsOnlyTheScriptsSteps) {
     const fs::path p = fs::path(RAYAUDIT_SOURCE_DIR) / file;
     // python3-yaml (ci/install-deps.sh): a real YAML parser.
     EXPECT_EQ(sh("/usr/bin/python3 -c \"import sys, yaml; d = yaml.safe_load(open(sys.argv[1])); "
-                 "assert isinstance(d, dict) and d\" " + p.string()), 0)
+                 "assert isinstance(d, dict) and d\" " +
+                 p.string()),
+              0)
         << file << " does not parse as YAML";
     const std::string text = slurp(p);
     const std::regex call("ci/audit-gate\\.sh ([a-z]+)");
@@ -83,7 +85,8 @@ TEST(CiFiles, GateScriptRunsFromAFreshClone) {
   EXPECT_NE(x.cases.find("watertight/double|grazing|"), std::string::npos) << x.cases;
   EXPECT_TRUE(fs::exists(dir / "out" / "report" / "index.html"));
   // Another seed against that baseline: refused in one line, exit 2.
-  EXPECT_EQ(sh(env + "AUDIT_SEED=2 AUDIT_REPORT=0 bash clone/ci/audit-gate.sh all > third.log 2>&1"), 2) << slurp(dir / "third.log");
+  EXPECT_EQ(sh(env + "AUDIT_SEED=2 AUDIT_REPORT=0 bash clone/ci/audit-gate.sh all > third.log 2>&1"), 2)
+      << slurp(dir / "third.log");
   fs::remove_all(dir);
 }
 

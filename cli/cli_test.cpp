@@ -65,8 +65,8 @@ TEST(Cli, BadSceneExits2WithFileAndPath) {
 }
 
 // The documents' method names and the modern references', by kind: the CLI's names are a contract.
-const std::vector<std::string> kTriangleMethods = {"angles", "cramer", "areas", "triple",
-                                                   "sameside", "moller", "watertight", "baldwin", "exact"};
+const std::vector<std::string> kTriangleMethods = {"angles", "cramer",     "areas",   "triple", "sameside",
+                                                   "moller", "watertight", "baldwin", "exact"};
 const std::vector<std::string> kSphereMethods = {"kraus", "codeproject", "codeproject-fixed", "stable"};
 
 TEST(Cli, UnknownMethodExits2ListingTheValidOnes) {
@@ -123,8 +123,7 @@ TEST(Cli, RendersWithEveryMethodInBothPrecisionsAndWithCulling) {
       for (std::size_t i = 3; i < img.rgb.size(); ++i) uniform = uniform && img.rgb[i] == img.rgb[i % 3];
       EXPECT_FALSE(uniform) << name << " " << precision << ": nothing was hit";
     }
-  const Result two = run("render " + scene + " -o " + (dir / "two.png").string() +
-                         " --method kraus --method stable");
+  const Result two = run("render " + scene + " -o " + (dir / "two.png").string() + " --method kraus --method stable");
   EXPECT_EQ(two.code, 2);
   EXPECT_NE(two.out.find("two sphere methods"), std::string::npos) << two.out;
   const Result bad = run("render " + scene + " -o " + (dir / "p.png").string() + " --precision half");

@@ -46,11 +46,11 @@ constexpr long long kMaxExportRays = 10000000;
 
 struct Args {
   std::string methods, precision = "float,double", families, json, csv, cases, export_cases, grade, shard;
-  std::string numbers = "hex";  // --export-cases: hex or decimal
-  std::string tracers;              // --tracers: whole tracers on closed meshes (validation/tracers)
-  long long tracer_rays = 2000;     // --tracer-rays: per shape, placement and scale
+  std::string numbers = "hex";       // --export-cases: hex or decimal
+  std::string tracers;               // --tracers: whole tracers on closed meshes (validation/tracers)
+  long long tracer_rays = 2000;      // --tracer-rays: per shape, placement and scale
   std::string ids, baseline, junit;  // --ids (replay), --baseline BASE.json, --junit FILE
-  long long rays = 200000;  // about 10 s for the full registry on 2 cores
+  long long rays = 200000;           // about 10 s for the full registry on 2 cores
   std::uint64_t seed = 1;
   int threads = 0;
   std::vector<std::string> merge_inputs;
@@ -67,7 +67,8 @@ std::string parse_shard(const std::string& text, Shard& out) {
   };
   if (slash == std::string::npos || !whole(text.substr(0, slash), out.k) || !whole(text.substr(slash + 1), out.n) ||
       out.k < 1 || out.k > out.n || out.n > kMaxShards)
-    return "'" + text + "' is not K/N with 1 <= K <= N <= " + std::to_string(kMaxShards) + " (e.g. 2/8: the second of eight)";
+    return "'" + text + "' is not K/N with 1 <= K <= N <= " + std::to_string(kMaxShards) +
+           " (e.g. 2/8: the second of eight)";
   return {};
 }
 
@@ -142,9 +143,12 @@ std::vector<const ra::Method*> chosen_methods(const std::string& list) {
 std::vector<Precision> chosen_precisions(const std::string& list) {
   std::vector<Precision> out;
   for (const auto& p : split_list(list, "--precision")) {
-    if (p == "float") out.push_back(Precision::f32);
-    else if (p == "double") out.push_back(Precision::f64);
-    else throw ra::InputError("audit: unknown precision '" + p + "' (float, double)");
+    if (p == "float")
+      out.push_back(Precision::f32);
+    else if (p == "double")
+      out.push_back(Precision::f64);
+    else
+      throw ra::InputError("audit: unknown precision '" + p + "' (float, double)");
   }
   if (out.empty()) throw ra::InputError("audit: --precision needs float and/or double");
   return out;
@@ -153,8 +157,7 @@ std::vector<Precision> chosen_precisions(const std::string& list) {
 std::vector<std::string> chosen_families(const std::string& list) {
   const auto names = split_list(list, "--families");
   for (const auto& n : names)
-    if (!find_family(n))
-      throw ra::InputError("audit: unknown family '" + n + "' (" + family_names() + ")");
+    if (!find_family(n)) throw ra::InputError("audit: unknown family '" + n + "' (" + family_names() + ")");
   return names;
 }
 
@@ -176,7 +179,8 @@ struct IdFilter {
     const auto colon = id.rfind(':');
     bool hit = false;
     for (std::size_t i = 0; i < wanted.size(); ++i)
-      if (wanted[i] == id || (colon != std::string::npos && wanted[i] == id.substr(0, colon))) hit = true, matched[i] = 1;
+      if (wanted[i] == id || (colon != std::string::npos && wanted[i] == id.substr(0, colon)))
+        hit = true, matched[i] = 1;
     return hit;
   }
   // The first id no case had, as the one-line refusal.
@@ -199,9 +203,12 @@ std::string duration(double s) {
   if (!std::isfinite(s)) return "?";
   const long long t = (long long)std::llround(s);
   char buf[48];
-  if (t >= 3600) std::snprintf(buf, sizeof buf, "%lldh%02lldm", t / 3600, t / 60 % 60);
-  else if (t >= 60) std::snprintf(buf, sizeof buf, "%lldm%02llds", t / 60, t % 60);
-  else std::snprintf(buf, sizeof buf, "%llds", t);
+  if (t >= 3600)
+    std::snprintf(buf, sizeof buf, "%lldh%02lldm", t / 3600, t / 60 % 60);
+  else if (t >= 60)
+    std::snprintf(buf, sizeof buf, "%lldm%02llds", t / 60, t % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%llds", t);
   return buf;
 }
 
@@ -231,9 +238,9 @@ std::function<void(std::uint64_t, std::uint64_t)> progress_reporter() {
                                      : "ETA " + duration(rate > 0 ? double(total - done) / rate : INFINITY);
     if (st->tty) {
       const int width = 30, filled = int(double(width) * frac);
-      std::fprintf(stderr, "\r[%s%s] %5.1f%% %s/%s rays  %s rays/s  %s   ", std::string(std::size_t(filled), '#').c_str(),
-                   std::string(std::size_t(width - filled), ' ').c_str(), 100 * frac, si(double(done)).c_str(),
-                   si(double(total)).c_str(), si(rate).c_str(), eta.c_str());
+      std::fprintf(stderr, "\r[%s%s] %5.1f%% %s/%s rays  %s rays/s  %s   ",
+                   std::string(std::size_t(filled), '#').c_str(), std::string(std::size_t(width - filled), ' ').c_str(),
+                   100 * frac, si(double(done)).c_str(), si(double(total)).c_str(), si(rate).c_str(), eta.c_str());
       if (finished) std::fprintf(stderr, "\n");
     } else {
       std::fprintf(stderr, "audit: %5.1f%% %llu/%llu rays, %s rays/s, %s\n", 100 * frac, (unsigned long long)done,
@@ -274,8 +281,8 @@ void audit_cases(const Args& a) {
     // single row shows (each is a boundary case, never wrong alone).
     struct Group {
       std::string key;
-      bool crossed[2] = {false, false};   // by precision: f32, f64
-      std::map<std::string, bool> hit;    // METHOD/PRECISION -> any hit
+      bool crossed[2] = {false, false};  // by precision: f32, f64
+      std::map<std::string, bool> hit;   // METHOD/PRECISION -> any hit
     } group;
     auto end_group = [&] {
       for (const auto& [subject, any] : group.hit) {
@@ -299,7 +306,8 @@ void audit_cases(const Args& a) {
       const ra::Rayf fray(c.ray);
       const auto ans_f = ra::oracle::triangle(ra::Rayd(fray), ra::Vec3d(fa), ra::Vec3d(fb), ra::Vec3d(fc));
       nlohmann::json answers = nlohmann::json::object();
-      std::printf("%-16.16s %-10s %-24.17g", c.id.c_str(), std::string(ra::oracle::verdict_name(ans.verdict)).c_str(), ans.t);
+      std::printf("%-16.16s %-10s %-24.17g", c.id.c_str(), std::string(ra::oracle::verdict_name(ans.verdict)).c_str(),
+                  ans.t);
       for (const auto* m : tri_methods) {
         std::string cell;
         for (Precision p : {Precision::f32, Precision::f64}) {
@@ -362,7 +370,8 @@ void audit_cases(const Args& a) {
 // ----------------------------------------------------------- --grade ---
 void grade(const Args& a) {
   if (!a.methods.empty()) throw ra::InputError("audit: --grade grades the answers file, not --methods: drop --methods");
-  if (!a.ids.empty()) throw ra::InputError("audit: --grade grades every answer; --ids goes with --cases alone (to show cases)");
+  if (!a.ids.empty())
+    throw ra::InputError("audit: --grade grades every answer; --ids goes with --cases alone (to show cases)");
   ra::OutputBatch outputs({a.json, a.csv, a.junit});
   const std::optional<nlohmann::json> base =
       a.baseline.empty() ? std::nullopt : std::optional(ra::baseline::read_audit_json(a.baseline));
@@ -374,11 +383,14 @@ void grade(const Args& a) {
   // and their precision, the default for the answers.
   const std::optional<CasesStamp> stamp = read_stamp(a.cases);
   if (stamp && stamp->version != RAYAUDIT_VERSION)
-    throw ra::InputError(ra::located(a.cases, 1, "exported by rayaudit " + stamp->version + ", this is " +
-                                                     RAYAUDIT_VERSION + ": export the cases again with this version"));
+    throw ra::InputError(ra::located(a.cases, 1,
+                                     "exported by rayaudit " + stamp->version + ", this is " + RAYAUDIT_VERSION +
+                                         ": export the cases again with this version"));
   Precision p = Precision::f64;
-  if (a.precision_given) p = ps[0];
-  else if (stamp) p = stamp->precision == "float" ? Precision::f32 : Precision::f64;
+  if (a.precision_given)
+    p = ps[0];
+  else if (stamp)
+    p = stamp->precision == "float" ? Precision::f32 : Precision::f64;
   else if (answers_look_float(a.grade, a.cases))
     // Graded as double, float rounding would read as errors of 1e10 ulps.
     throw ra::InputError("audit: every t in " + a.grade + " and every coordinate of " + a.cases +
@@ -391,14 +403,19 @@ void grade(const Args& a) {
     rep.rays = stamp->rays;
     for (const Cell& c : rep.cells)
       if (std::find(stamp->families.begin(), stamp->families.end(), c.family) == stamp->families.end())
-        throw ra::InputError(ra::located(a.cases, 1, "the stamp lists the families " + join(stamp->families) +
-                                                         ", but rows of family '" + c.family + "' follow"));
+        throw ra::InputError(ra::located(a.cases, 1,
+                                         "the stamp lists the families " + join(stamp->families) +
+                                             ", but rows of family '" + c.family + "' follow"));
   }
   std::fputs(rep.summary_table().c_str(), stdout);
   nlohmann::json j = rep.to_json();
   j["graded"] = {{"answers", a.grade}, {"cases", a.cases}};
-  if (stamp) j["graded"]["stamp"] = {{"version", stamp->version}, {"seed", stamp->seed}, {"rays", stamp->rays},
-                                     {"precision", stamp->precision}, {"families", stamp->families}};
+  if (stamp)
+    j["graded"]["stamp"] = {{"version", stamp->version},
+                            {"seed", stamp->seed},
+                            {"rays", stamp->rays},
+                            {"precision", stamp->precision},
+                            {"families", stamp->families}};
   const ra::baseline::GateResult g =
       ra::baseline::gate(j, base, {.baseline_name = a.baseline, .junit = a.junit, .suite = "rayaudit audit --grade"});
   if (!a.json.empty())
@@ -412,7 +429,8 @@ void grade(const Args& a) {
 void export_cases(const Args& a) {
   if (!a.json.empty() || !a.csv.empty())
     throw ra::InputError("audit: --export-cases writes only the cases CSV; run the audit separately for --json/--csv");
-  if (!a.methods.empty()) throw ra::InputError("audit: --export-cases exports cases, not methods' answers: drop --methods");
+  if (!a.methods.empty())
+    throw ra::InputError("audit: --export-cases exports cases, not methods' answers: drop --methods");
   // The rows are streamed to the file (memory does not grow with --rays);
   // the limit bounds the file (about 350 bytes a case) and the time.
   if (a.rays > kMaxExportRays)
@@ -422,7 +440,8 @@ void export_cases(const Args& a) {
   // One file holds one precision's inputs (a list of two was
   // taken as double and the float half dropped silently).
   if (a.precision_given && precisions.size() != 1)
-    throw ra::InputError("--precision: --export-cases takes one precision (float or double), got '" + a.precision + "'");
+    throw ra::InputError("--precision: --export-cases takes one precision (float or double), got '" + a.precision +
+                         "'");
   ra::declare_output(a.export_cases);
   // Exported inputs are double unless only float was asked for.
   const Precision p = precisions.size() == 1 ? precisions[0] : Precision::f64;
@@ -436,8 +455,9 @@ void export_cases(const Args& a) {
       throw ra::InputError("audit: --export-cases: '" + name +
                            "' is a sphere family; the cases CSV holds rays and triangles only");
     if (f->secondary)
-      throw ra::InputError("audit: --export-cases: 'secondary' has no fixed cases (its rays start at each method's own "
-                           "hit point); audit it with --families secondary");
+      throw ra::InputError(
+          "audit: --export-cases: 'secondary' has no fixed cases (its rays start at each method's own "
+          "hit point); audit it with --families secondary");
   }
   if (fams.empty())
     for (const Family& f : families())
@@ -460,7 +480,8 @@ void export_cases(const Args& a) {
       if (ids.take(r.id)) out << ra::audit::cases_csv_row(r, numbers), ++rows;
     });
     out.close();
-    if (!out) throw ra::InputError(ra::located(a.export_cases, 0, std::string("cannot write: ") + std::strerror(errno)));
+    if (!out)
+      throw ra::InputError(ra::located(a.export_cases, 0, std::string("cannot write: ") + std::strerror(errno)));
   });
   std::printf("wrote %lld %s cases to %s%s\n", rows, precision_name(p), a.export_cases.c_str(),
               numbers == ra::audit::Numbers::decimal ? " (decimal numbers)" : "");
@@ -511,8 +532,10 @@ void audit(const Args& a) {
   std::vector<SphereSubject> spheres;
   for (const ra::Method* m : ms)
     for (Precision p : ps) {
-      if (m->kind == ra::Kind::triangle) tris.push_back(registry_triangle(*m, p));
-      else spheres.push_back(registry_sphere(*m, p));
+      if (m->kind == ra::Kind::triangle)
+        tris.push_back(registry_triangle(*m, p));
+      else
+        spheres.push_back(registry_sphere(*m, p));
     }
   // A peer answers at its own precision only (Embree's API is float, CGAL's
   // Epick double): graded when --precision includes it.
@@ -534,15 +557,16 @@ void audit(const Args& a) {
       const Family* f = find_family(name);
       const bool graded = f->kind == ra::Kind::triangle ? !tris.empty() : !spheres.empty();
       if (!graded)
-        throw ra::InputError("audit: family '" + name + "' is a " + (f->kind == ra::Kind::triangle ? "triangle" : "sphere") +
-                             " family, but no " + (f->kind == ra::Kind::triangle ? "triangle" : "sphere") +
-                             " method is chosen (--methods)");
+        throw ra::InputError("audit: family '" + name + "' is a " +
+                             (f->kind == ra::Kind::triangle ? "triangle" : "sphere") + " family, but no " +
+                             (f->kind == ra::Kind::triangle ? "triangle" : "sphere") + " method is chosen (--methods)");
     }
   }
   const Report rep = run(tris, spheres, opt);
   std::fputs(rep.summary_table().c_str(), stdout);
   if (opt.shard)
-    std::printf("shard %s: partial counts; combine every shard's --json with `rayaudit audit merge`\n", a.shard.c_str());
+    std::printf("shard %s: partial counts; combine every shard's --json with `rayaudit audit merge`\n",
+                a.shard.c_str());
   nlohmann::json out = rep.to_json();
   if (!tracer_subjects.empty()) {
     ra::tracers::Options to;
@@ -556,8 +580,10 @@ void audit(const Args& a) {
   // (a user's --methods), not the whole registry's documented failures.
   ra::baseline::GateResult g;
   if (!opt.shard)
-    g = ra::baseline::gate(out, base, {.baseline_name = a.baseline, .junit = a.junit, .failure_lines = rep.subjects.size() <= 4});
-  if (!a.json.empty()) ra::write_text_atomically(a.json, out.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    g = ra::baseline::gate(out, base,
+                           {.baseline_name = a.baseline, .junit = a.junit, .failure_lines = rep.subjects.size() <= 4});
+  if (!a.json.empty())
+    ra::write_text_atomically(a.json, out.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.csv.empty()) ra::write_text_atomically(a.csv, rep.to_csv());
   outputs.commit();
   if (g.rose) throw ra::CheckFailed("audit: worse than the baseline " + a.baseline + " (the rows marked ROSE)");
@@ -582,7 +608,8 @@ constexpr std::uintmax_t kMaxShardBytes = 8u << 20;
 // What must agree between shards of one run, as "name: value" texts.
 std::vector<std::pair<std::string, std::string>> run_identity(const nlohmann::json& json, const Report& report) {
   std::string cells;
-  for (const auto& c : json["cells"]) cells += c.value("subject", "") + "|" + c.value("family", "") + "|" + c.value("sweep", "") + ";";
+  for (const auto& c : json["cells"])
+    cells += c.value("subject", "") + "|" + c.value("family", "") + "|" + c.value("sweep", "") + ";";
   std::string methods;
   for (const auto& s : report.subjects) methods += (methods.empty() ? "" : ",") + s;
   return {{"version", json.value("version", "(none)")},
@@ -597,9 +624,10 @@ ShardFile read_shard(const std::string& path) {
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   if (!ec && size > kMaxShardBytes)
-    throw ra::InputError(ra::located(path, 0, std::to_string(size >> 20) + " MB is larger than a shard can be (at most " +
-                                                  std::to_string(kMaxShardBytes >> 20) +
-                                                  " MB; a full audit's shard is about 1 MB)"));
+    throw ra::InputError(ra::located(path, 0,
+                                     std::to_string(size >> 20) + " MB is larger than a shard can be (at most " +
+                                         std::to_string(kMaxShardBytes >> 20) +
+                                         " MB; a full audit's shard is about 1 MB)"));
   // read_json_file: a directory or FIFO named, not read or waited on; a
   // syntax error at its line; a key given twice refused.
   const nlohmann::json json = ra::read_json_file(path);
@@ -625,8 +653,9 @@ void merge(const Args& a) {
   // added to the sum, then dropped.
   const ShardFile first = read_shard(a.merge_inputs[0]);
   if (first.version != RAYAUDIT_VERSION)
-    throw ra::InputError(ra::located(first.path, 0, "written by rayaudit " + first.version +
-                                                         "; merge with that version (this is " + RAYAUDIT_VERSION + ")"));
+    throw ra::InputError(ra::located(
+        first.path, 0,
+        "written by rayaudit " + first.version + "; merge with that version (this is " + RAYAUDIT_VERSION + ")"));
   // Shards by k in a map, not a table of n entries (n = 4e9 was a bad_alloc).
   const std::uint64_t n = first.report.shard->n;
   std::map<std::uint64_t, std::string> by_k;
@@ -639,18 +668,18 @@ void merge(const Args& a) {
       if (f.identity[k].second != first.identity[k].second) {
         std::string mine = f.identity[k].second, theirs = first.identity[k].second;
         if (mine.size() > 60 || theirs.size() > 60) mine = theirs = "";  // the lists: just say they differ
-        throw ra::InputError(ra::located("audit merge", 0, f.path + " and " + first.path +
-                                                               " are shards of different runs: " + f.identity[k].first +
-                                                               (mine.empty() ? " differ" : " " + mine + " vs " + theirs)));
+        throw ra::InputError(ra::located("audit merge", 0,
+                                         f.path + " and " + first.path +
+                                             " are shards of different runs: " + f.identity[k].first +
+                                             (mine.empty() ? " differ" : " " + mine + " vs " + theirs)));
       }
     const std::uint64_t k = f.report.shard->k;
     if (k < 1 || k > n) throw ra::InputError(ra::located(f.path, 0, "shard k out of range 1..n"));
     if (by_k.count(k))
-      throw ra::InputError("audit merge: " + f.path + " and " + by_k[k] + " are both shard " + std::to_string(k) +
-                           "/" + std::to_string(n));
+      throw ra::InputError("audit merge: " + f.path + " and " + by_k[k] + " are both shard " + std::to_string(k) + "/" +
+                           std::to_string(n));
     by_k[k] = f.path;
-    if (i)
-      try {
+    if (i) try {
         for (std::size_t c = 0; c < rep.cells.size(); ++c) rep.cells[c].stats.merge(f.report.cells[c].stats);
       } catch (const std::overflow_error& e) {
         throw ra::InputError(ra::located(f.path, 0, e.what()));
@@ -675,7 +704,9 @@ void setup(CLI::App& app) {
                   "Comma-separated methods and peers (embree, embree-robust, cgal-epick, pov-mesh2), or all, peers "
                   "(default: every triangle and sphere method)")
       ->check(ra::cli::non_empty_list());
-  cmd->add_option("--precision", a->precision, "float, double or both")->capture_default_str()->check(ra::cli::non_empty_list());
+  cmd->add_option("--precision", a->precision, "float, double or both")
+      ->capture_default_str()
+      ->check(ra::cli::non_empty_list());
   cmd->add_option("--families", a->families, "Comma-separated families (default all): " + family_names())
       ->check(ra::cli::non_empty_list());
   cmd->add_option("--rays", a->rays,
@@ -695,8 +726,9 @@ void setup(CLI::App& app) {
             for (long long k = e == std::string::npos ? 0 : std::stoll(ex); k > 0 && n <= kMaxRays; --k) n *= 10;
             if (n < 1) return "at least 1 ray";
             if (n > kMaxRays)
-              return v + " is above the limit of 10000000000 (1e10) rays per family, about 30 hours of every "
-                         "method on 2 cores; spread a run that size over machines with --shard K/N";
+              return v +
+                     " is above the limit of 10000000000 (1e10) rays per family, about 30 hours of every "
+                     "method on 2 cores; spread a run that size over machines with --shard K/N";
             v = std::to_string((long long)n);  // what the option then holds: 1e6 as 1000000
             return {};
           },
@@ -708,8 +740,10 @@ void setup(CLI::App& app) {
             // CLI11 would saturate 2^64 and beyond to 2^64-1: out of range is an error.
             std::uint64_t x = 0;
             const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-            if (ec == std::errc::result_out_of_range) return std::string("the seed is at most 18446744073709551615 (2^64-1)");
-            if (ec != std::errc() || end != v.data() + v.size()) return std::string("the seed is a non-negative integer");
+            if (ec == std::errc::result_out_of_range)
+              return std::string("the seed is at most 18446744073709551615 (2^64-1)");
+            if (ec != std::errc() || end != v.data() + v.size())
+              return std::string("the seed is a non-negative integer");
             return std::string();
           },
           "UINT64"));
@@ -719,8 +753,10 @@ void setup(CLI::App& app) {
   cmd->add_option("--json", a->json, "Write every count to this JSON file");
   cmd->add_option("--tracers", a->tracers,
                   "Also grade whole tracers on closed meshes placed out to 1e7 and scaled 1e-4..1e4 (the JSON's "
-                  "\"tracers\"): " + ra::tracers::known_names());
-  cmd->add_option("--tracer-rays", a->tracer_rays, "Rays per closed mesh, placement and scale for --tracers (default 2000)")
+                  "\"tracers\"): " +
+                      ra::tracers::known_names());
+  cmd->add_option("--tracer-rays", a->tracer_rays,
+                  "Rays per closed mesh, placement and scale for --tracers (default 2000)")
       ->check(CLI::Range(2LL, 100000000LL));
   cmd->add_option("--csv", a->csv, "Write one row per method x precision x family x sweep value");
   auto* cases = cmd->add_option("--cases", a->cases,
@@ -754,8 +790,7 @@ void setup(CLI::App& app) {
   cmd->add_option("--junit", a->junit, "Write JUnit XML: one test case per method x precision x family");
   auto* merge_cmd = cmd->add_subcommand(
       "merge", "Combine the --json outputs of every shard of one audit into what the unsharded run writes");
-  merge_cmd->add_option("shards", a->merge_inputs, "The shards' JSON files (audit --shard K/N --json)")
-      ->required();
+  merge_cmd->add_option("shards", a->merge_inputs, "The shards' JSON files (audit --shard K/N --json)")->required();
   merge_cmd->add_option("--json", a->json, "Write the merged JSON here")->required();
   merge_cmd->add_option("--csv", a->csv, "Write the merged per-cell CSV here");
   merge_cmd->callback([a] { merge(*a); });

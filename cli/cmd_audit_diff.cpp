@@ -21,10 +21,11 @@ void diff(const Args& a) {
   ra::OutputBatch outputs({a.junit});
   const nlohmann::json before = ra::baseline::read_audit_json(a.before);
   const nlohmann::json after = ra::baseline::read_audit_json(a.after);
-  const ra::baseline::GateResult g = ra::baseline::gate(
-      after, before, {.baseline_name = a.before, .junit = a.junit, .suite = "rayaudit audit diff"});
+  const ra::baseline::GateResult g =
+      ra::baseline::gate(after, before, {.baseline_name = a.before, .junit = a.junit, .suite = "rayaudit audit diff"});
   outputs.commit();
-  if (g.rose) throw ra::CheckFailed("audit diff: " + a.after + " is worse than " + a.before + " (the rows marked ROSE)");
+  if (g.rose)
+    throw ra::CheckFailed("audit diff: " + a.after + " is worse than " + a.before + " (the rows marked ROSE)");
 }
 
 void setup(CLI::App& app) {

@@ -60,11 +60,14 @@ void run(const Args& a, CLI::App* cmd, const std::vector<std::string>& extras) {
 
 void setup(CLI::App& app) {
   auto args = std::make_shared<Args>();
-  auto* cmd = app.add_subcommand(
-      "bench", "Benchmarks: every method, the documents' optimisations, Embree, POV-Ray, tinyobjloader, CGAL "
-               "(Google Benchmark; its --benchmark_* flags pass through)");
+  auto* cmd =
+      app.add_subcommand("bench",
+                         "Benchmarks: every method, the documents' optimisations, Embree, POV-Ray, tinyobjloader, CGAL "
+                         "(Google Benchmark; its --benchmark_* flags pass through)");
   cmd->add_flag("--quick", args->quick, "Fewer repetitions, mesh ladder up to the bunny (under 2 minutes)");
-  cmd->add_option("--json", args->json, "Write Google Benchmark's JSON here (compare.py reads it), with every repetition, its calibration, and each row's median, quartiles and range under \"rayaudit\"");
+  cmd->add_option("--json", args->json,
+                  "Write Google Benchmark's JSON here (compare.py reads it), with every repetition, its calibration, "
+                  "and each row's median, quartiles and range under \"rayaudit\"");
   cmd->add_option("--threads", args->threads, "Threads of the all-threads rows (default: all cores)")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--filter", args->filter,

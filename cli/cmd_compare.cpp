@@ -68,13 +68,22 @@ void run_random(const Args& a) {
   namespace fs = std::filesystem;
   if (a.random < 1 || a.random > 100000) throw ra::InputError("--random must be between 1 and 100000");
   if (!a.scene.empty()) throw ra::InputError("--random makes its own scenes: give no SCENE");
-  for (const auto& [flag, set] : std::vector<std::pair<const char*, bool>>{
-           {"--json", !a.json_out.empty()}, {"--diff", !a.diff_out.empty()}, {"--ours", !a.ours_out.empty()},
-           {"--pov", !a.pov_out.empty()}, {"--tolerance", !a.tolerance.empty()}, {"--width", a.width > 0},
-           {"--height", a.height > 0}, {"--bits", a.bits != 8}, {"--keep-pov-dir", a.keep},
-           {"--skip-inexpressible", a.skip_inexpressible}, {"--accept-explained", a.accept_explained},
-           {"--image", !a.image.empty()}})
-    if (set) throw ra::InputError(std::string(flag) + " cannot be used with --random (it compares at 8 bits and explains every pixel)");
+  for (const auto& [flag, set] :
+       std::vector<std::pair<const char*, bool>>{{"--json", !a.json_out.empty()},
+                                                 {"--diff", !a.diff_out.empty()},
+                                                 {"--ours", !a.ours_out.empty()},
+                                                 {"--pov", !a.pov_out.empty()},
+                                                 {"--tolerance", !a.tolerance.empty()},
+                                                 {"--width", a.width > 0},
+                                                 {"--height", a.height > 0},
+                                                 {"--bits", a.bits != 8},
+                                                 {"--keep-pov-dir", a.keep},
+                                                 {"--skip-inexpressible", a.skip_inexpressible},
+                                                 {"--accept-explained", a.accept_explained},
+                                                 {"--image", !a.image.empty()}})
+    if (set)
+      throw ra::InputError(std::string(flag) +
+                           " cannot be used with --random (it compares at 8 bits and explains every pixel)");
   ra::find_povray();
   if (ra::random_scene_meshes().empty())
     std::cout << "note: no corpus meshes in " << ra::cache_dir().string()
@@ -120,8 +129,12 @@ void run_random(const Args& a) {
       if (p.cause.empty() && (!first || p.levels > first->levels)) first = &p;
     std::cout << name << ": " << r.differing << " pixels differ, " << r.unexplained() << " unexplained (largest at ("
               << first->x << ", " << first->y << "), " << first->levels << " levels)";
-    nlohmann::json entry = {{"scene", name}, {"x", first->x}, {"y", first->y}, {"levels", first->levels},
-                            {"unexplained_pixels", r.unexplained()}, {"differing_pixels", r.differing}};
+    nlohmann::json entry = {{"scene", name},
+                            {"x", first->x},
+                            {"y", first->y},
+                            {"levels", first->levels},
+                            {"unexplained_pixels", r.unexplained()},
+                            {"differing_pixels", r.differing}};
     if (!a.out_dir.empty()) {
       int tries = 0;
       const nlohmann::json small =
@@ -146,13 +159,15 @@ void run_random(const Args& a) {
   std::string counts;
   for (const auto& [name, k] : causes) counts += (counts.empty() ? "" : ", ") + name + " x" + std::to_string(k);
   if (!counts.empty()) std::cout << "explained pixels by cause: " << counts << "\n";
-  if (!a.out_dir.empty()) ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json", report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  if (!a.out_dir.empty())
+    ra::write_text_atomically(fs::path(a.out_dir) / "unexplained.json",
+                              report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (!a.junit.empty()) ra::junit::write(a.junit, {junit});
   outputs.commit();
   if (unexplained_scenes > 0)
-    throw ra::CheckFailed(std::to_string(unexplained_scenes) + " random scenes have pixels no known cause explains" +
-                          (a.out_dir.empty() ? std::string(" (give --out DIR for minimal scenes)")
-                                             : "; minimal scenes in " + a.out_dir));
+    throw ra::CheckFailed(
+        std::to_string(unexplained_scenes) + " random scenes have pixels no known cause explains" +
+        (a.out_dir.empty() ? std::string(" (give --out DIR for minimal scenes)") : "; minimal scenes in " + a.out_dir));
 }
 
 // --explain for another renderer's image: our models explain a difference
@@ -233,8 +248,8 @@ void run(const Args& a) {
     if (!why.empty())
       throw ra::InputError(ra::located(a.tolerance, 0, why == "no such file" ? "no such tolerance file" : why));
   }
-  const ra::PovTolerance tol =
-      ra::load_pov_tolerance(a.tolerance.empty() ? ra::pov_tolerance_path(a.scene) : std::filesystem::path(a.tolerance));
+  const ra::PovTolerance tol = ra::load_pov_tolerance(a.tolerance.empty() ? ra::pov_tolerance_path(a.scene)
+                                                                          : std::filesystem::path(a.tolerance));
   // A tolerance file named on the command line is for this image: one for
   // 16x16 silently judged nothing of an 8x8 render. The
   // scene's default file keeps its note ("for WxH, not this size: none
@@ -242,10 +257,10 @@ void run(const Args& a) {
   if (!a.tolerance.empty())
     for (auto [key, want, got] : {std::tuple{"width", tol.width, scene.width}, {"height", tol.height, scene.height}})
       if (want && *want != got)
-        throw ra::InputError(ra::located(a.tolerance, 0, std::string("/") + key + ": " + std::to_string(*want) +
-                                                             ", but the image is " + std::to_string(got) +
-                                                             (key[0] == 'w' ? " wide" : " high") +
-                                                             " (give --width/--height, or a tolerance for this size)"));
+        throw ra::InputError(ra::located(a.tolerance, 0,
+                                         std::string("/") + key + ": " + std::to_string(*want) + ", but the image is " +
+                                             std::to_string(got) + (key[0] == 'w' ? " wide" : " high") +
+                                             " (give --width/--height, or a tolerance for this size)"));
 
   // Another renderer's image, checked against the scene's render before
   // either render is made.
@@ -281,8 +296,8 @@ void run(const Args& a) {
     explained = with_image ? explain_their_differences(scene, ours, pov.image, c, opt, a.bits)
                            : ra::explain_differences(scene, ours, pov.image, c, opt);
     for (const auto& e : explained)
-      std::cout << "  (" << e.x << ", " << e.y << ") " << e.levels << " levels: "
-                << (e.cause.empty() ? "none of the known causes" : e.cause) << "\n";
+      std::cout << "  (" << e.x << ", " << e.y << ") " << e.levels
+                << " levels: " << (e.cause.empty() ? "none of the known causes" : e.cause) << "\n";
   }
   if (!tol.notes.empty()) std::cout << "notes (" << tol.file.string() << "): " << tol.notes << "\n";
   if (!pov.dir.empty()) std::cout << "POV-Ray's working directory: " << pov.dir.string() << "\n";
@@ -318,13 +333,14 @@ void run(const Args& a) {
     const bool pass = a.accept_explained ? unexplained == 0 : v.pass;
     std::string lines;
     for (const auto& line : v.lines) lines += line + "\n";
-    const std::string message =
-        a.accept_explained ? std::to_string(unexplained) + " of " + std::to_string(c.differences.size()) +
-                                 " differing pixels have no known cause"
-                           : "our render differs from POV-Ray's beyond the tolerance";
-    ra::junit::write(a.junit, {{"rayaudit compare", {{"compare", a.scene, pass ? ra::junit::Case::Status::pass
-                                                                                 : ra::junit::Case::Status::fail,
-                                                       pass ? "" : message, ra::summary(c) + lines, 0}}}});
+    const std::string message = a.accept_explained
+                                    ? std::to_string(unexplained) + " of " + std::to_string(c.differences.size()) +
+                                          " differing pixels have no known cause"
+                                    : "our render differs from POV-Ray's beyond the tolerance";
+    ra::junit::write(a.junit,
+                     {{"rayaudit compare",
+                       {{"compare", a.scene, pass ? ra::junit::Case::Status::pass : ra::junit::Case::Status::fail,
+                         pass ? "" : message, ra::summary(c) + lines, 0}}}});
   }
   outputs.commit();  // also when the check fails: the diff and JSON say why
   if (a.accept_explained) {
@@ -339,10 +355,9 @@ void run(const Args& a) {
     return;
   }
   if (!v.pass)
-    throw ra::CheckFailed(a.scene + ": " + (with_image ? a.image : std::string("our render")) +
-                          " differs from POV-Ray's beyond what " +
-                          (tol.file.empty() ? std::string("the default (identical at 8 bits)") : tol.file.string()) +
-                          " explains");
+    throw ra::CheckFailed(
+        a.scene + ": " + (with_image ? a.image : std::string("our render")) + " differs from POV-Ray's beyond what " +
+        (tol.file.empty() ? std::string("the default (identical at 8 bits)") : tol.file.string()) + " explains");
   std::cout << "within tolerance: yes\n";
 }
 
@@ -350,16 +365,17 @@ void setup(CLI::App& app) {
   auto args = std::make_shared<Args>();
   auto* cmd = app.add_subcommand("compare", "Render a scene with rayaudit and with POV-Ray 3.7 and compare them");
   cmd->add_option("scene", args->scene, "Scene file (.json) or mesh (.obj)");
-  auto* random_opt = cmd->add_option("--random", args->random,
-                  "Compare N random scenes (spheres, planes, triangles, corpus meshes), explaining every differing "
-                  "pixel; exit 1 if any has no known cause");
-  auto* seed_opt = cmd->add_option("--seed", args->seed, "Seed of the --random batch (default 1)")
-                       ->check(CLI::Validator(
-                           [](std::string& v) {
-                             return v.find('-') == std::string::npos ? std::string()
-                                                                     : "the seed is a non-negative integer";
-                           },
-                           "UINT64"));
+  auto* random_opt =
+      cmd->add_option("--random", args->random,
+                      "Compare N random scenes (spheres, planes, triangles, corpus meshes), explaining every differing "
+                      "pixel; exit 1 if any has no known cause");
+  auto* seed_opt =
+      cmd->add_option("--seed", args->seed, "Seed of the --random batch (default 1)")
+          ->check(CLI::Validator(
+              [](std::string& v) {
+                return v.find('-') == std::string::npos ? std::string() : "the seed is a non-negative integer";
+              },
+              "UINT64"));
   cmd->add_option("--out", args->out_dir,
                   "With --random: write each unexplained difference here as a minimal scene (shrunk), with "
                   "unexplained.json listing them");
@@ -378,7 +394,8 @@ void setup(CLI::App& app) {
   cmd->add_option("--tolerance", args->tolerance, "Tolerance file (default scenes/pov/NAME.json beside the scene)");
   cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
-  cmd->add_option("--threads", args->threads, "Threads for our render (default: all cores)")->check(CLI::Range(0, 1024));
+  cmd->add_option("--threads", args->threads, "Threads for our render (default: all cores)")
+      ->check(CLI::Range(0, 1024));
   cmd->add_flag("--explain", args->explain,
                 "Test each differing pixel for the known causes (float32 mesh data, equal-normal triangles, "
                 "POV's mesh2 hit point, its shadow cache)");

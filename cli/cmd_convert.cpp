@@ -28,9 +28,12 @@ void setup(CLI::App& app) {
     std::string fmt = o->from;
     if (fmt.empty()) {
       const std::string ext = std::filesystem::path(o->in).extension().string();
-      if (ext == ".ply" || ext == ".PLY") fmt = "ply";
-      else if (ext == ".off" || ext == ".OFF") fmt = "off";
-      else throw ra::InputError(ra::located(o->in, 0, "unknown mesh format (use --from ply|off)"));
+      if (ext == ".ply" || ext == ".PLY")
+        fmt = "ply";
+      else if (ext == ".off" || ext == ".OFF")
+        fmt = "off";
+      else
+        throw ra::InputError(ra::located(o->in, 0, "unknown mesh format (use --from ply|off)"));
     }
     const ra::PolyMesh m = fmt == "ply" ? ra::read_ply(o->in) : ra::read_off(o->in);
     ra::write_obj(m, o->out, "converted by rayaudit convert from " + std::filesystem::path(o->in).filename().string());

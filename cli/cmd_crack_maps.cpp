@@ -147,7 +147,8 @@ void run(const Args& a) {
   for (std::size_t i = 1; i < outputs.size(); ++i)
     for (std::size_t k = 0; k < i; ++k)
       if (outputs[k] == outputs[i])
-        throw ra::InputError(outputs[i].string() + ": two maps would have this name (meshes of one name, or "
+        throw ra::InputError(outputs[i].string() +
+                             ": two maps would have this name (meshes of one name, or "
                              "offsets or methods given twice): rename the mesh or drop the repeat");
   for (const auto& o : outputs) ra::check_output_name(o);
   // The directory is made now and removed again if the run fails in it.
@@ -172,8 +173,7 @@ void run(const Args& a) {
                        "grey: hit (shaded by angle); red: leak (the oracle or the watertight method finds a crossing, "
                        "this method none); blue: hit where the oracle finds no crossing; white: background"}};
   nlohmann::json ms = nlohmann::json::array(), entries = nlohmann::json::array();
-  for (const auto& m : meshes)
-    ms.push_back({{"name", m.name}, {"source", m.source}, {"triangles", m.faces.size()}});
+  for (const auto& m : meshes) ms.push_back({{"name", m.name}, {"source", m.source}, {"triangles", m.faces.size()}});
   j["meshes"] = ms;
   std::printf("%-14s %-16s %10s %8s %8s %8s\n", "MESH", "METHOD", "OFFSET", "SURFACE", "LEAKS", "F.HITS");
   if (maps.size() + 1 != outputs.size()) throw std::logic_error("crack-maps: maps and their names disagree");
@@ -189,8 +189,8 @@ void run(const Args& a) {
                        {"leaks", m.leaks},
                        {"false_hits", m.false_hits},
                        {"image", outputs[i + 1].filename().string()}});
-    std::printf("%-14s %-16s %10g %8lld %8lld %8lld\n", m.mesh.c_str(), m.method.c_str(), m.offset, m.surface,
-                m.leaks, m.false_hits);
+    std::printf("%-14s %-16s %10g %8lld %8lld %8lld\n", m.mesh.c_str(), m.method.c_str(), m.offset, m.surface, m.leaks,
+                m.false_hits);
   }
   j["maps"] = entries;
   ra::write_text_atomically(outputs[0], j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
@@ -205,12 +205,14 @@ void setup(CLI::App& app) {
       "crack-maps", "Render closed meshes far from the origin with each triangle method in float; paint leaks red");
   cmd->add_option("-o,--out", a->out, "Directory for crack_maps.json and one PNG per mesh x method x offset")
       ->required();
-  cmd->add_option("--mesh", a->meshes,
-                  "A closed OBJ to map besides the audit's sphere (default: the ladder's elephant_cgal.obj, 5,558 triangles)");
+  cmd->add_option(
+      "--mesh", a->meshes,
+      "A closed OBJ to map besides the audit's sphere (default: the ladder's elephant_cgal.obj, 5,558 triangles)");
   cmd->add_option("--offsets", a->offsets, "Comma-separated offsets of the mesh centre (o, o, o)")
       ->capture_default_str()
       ->check(ra::cli::non_empty_list());
-  cmd->add_option("--methods", a->methods, "Comma-separated triangle methods (default: all)")->check(ra::cli::non_empty_list());
+  cmd->add_option("--methods", a->methods, "Comma-separated triangle methods (default: all)")
+      ->check(ra::cli::non_empty_list());
   cmd->add_option("--size", a->size, "Pixels a side")->capture_default_str();
   cmd->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   cmd->callback([a] { run(*a); });

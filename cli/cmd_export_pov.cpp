@@ -29,7 +29,8 @@ void run(const Args& a) {
   const std::filesystem::path out(a.out);
   if (out.extension() != ".pov") throw ra::InputError(a.out + ": output must be a .pov file");
   // One path given twice would keep only the later file (the ini over the scene).
-  if (!a.ini.empty() && std::filesystem::absolute(a.ini).lexically_normal() == std::filesystem::absolute(out).lexically_normal())
+  if (!a.ini.empty() &&
+      std::filesystem::absolute(a.ini).lexically_normal() == std::filesystem::absolute(out).lexically_normal())
     throw ra::InputError(a.ini + ": --ini names the same file as -o");
   ra::OutputBatch outputs({out, a.ini});
   ra::Scene scene = ra::load_scene(a.scene);
@@ -46,8 +47,8 @@ void run(const Args& a) {
   outputs.commit();
   std::cout << "wrote " << out.string();
   if (!ex.images.empty()) std::cout << " and " << ex.images.size() << " image(s) beside it";
-  std::cout << "\nrender it from " << dir.string() << " with: povray " << (a.ini.empty() ? "YOUR.ini" : a.ini)
-            << " +I" << out.filename().string() << " +W" << scene.width << " +H" << scene.height
+  std::cout << "\nrender it from " << dir.string() << " with: povray " << (a.ini.empty() ? "YOUR.ini" : a.ini) << " +I"
+            << out.filename().string() << " +W" << scene.width << " +H" << scene.height
             << " +WT1 (ini: Antialias=Off, File_Gamma=1.0, Output_File_Type=N; see --ini)\n";
 }
 

@@ -63,10 +63,11 @@ double inc_number(const std::string& file, long line, std::string s) {
   const auto b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
   s = b == std::string::npos ? "" : s.substr(b, e - b + 1);
   char* end = nullptr;
-  const double v = s.empty() || s.find_first_not_of("+-0123456789.eE") != std::string::npos
-                       ? NAN : std::strtod(s.c_str(), &end);
+  const double v =
+      s.empty() || s.find_first_not_of("+-0123456789.eE") != std::string::npos ? NAN : std::strtod(s.c_str(), &end);
   if (s.empty() || !end || *end || !std::isfinite(v) || std::fabs(v) > 1e30)
-    throw ra::InputError(ra::located(file, line, "number '" + s.substr(0, 40) + "' is not a finite number within 1e30"));
+    throw ra::InputError(
+        ra::located(file, line, "number '" + s.substr(0, 40) + "' is not a finite number within 1e30"));
   return v;
 }
 
@@ -82,8 +83,7 @@ std::vector<Patch> read_teapot_inc(const std::string& file) {
   const std::string text = ss.str();
   std::vector<Patch> patches;
   LineOf line_of{text};
-  for (std::size_t at = text.find("bicubic_patch"); at != std::string::npos;
-       at = text.find("bicubic_patch", at + 1)) {
+  for (std::size_t at = text.find("bicubic_patch"); at != std::string::npos; at = text.find("bicubic_patch", at + 1)) {
     const long line = line_of(at);
     const std::size_t open = text.find('{', at), close = text.find('}', at);
     if (open == std::string::npos || close == std::string::npos || close < open)
@@ -100,15 +100,16 @@ std::vector<Patch> read_teapot_inc(const std::string& file) {
       std::stringstream fields(body);
       for (std::string f; std::getline(fields, f, ',');) parts.push_back(f);
       if (parts.size() != 3)
-        throw ra::InputError(ra::located(file, vline, "vector with " + std::to_string(parts.size()) +
-                                                          " components (3 needed)"));
-      if (k < 16) p[k] = {inc_number(file, vline, parts[0]), inc_number(file, vline, parts[1]),
-                          inc_number(file, vline, parts[2])};
+        throw ra::InputError(
+            ra::located(file, vline, "vector with " + std::to_string(parts.size()) + " components (3 needed)"));
+      if (k < 16)
+        p[k] = {inc_number(file, vline, parts[0]), inc_number(file, vline, parts[1]),
+                inc_number(file, vline, parts[2])};
       ++k;
     }
     if (k != 16)
-      throw ra::InputError(ra::located(file, line, "bicubic_patch with " + std::to_string(k) +
-                                                       " control points (16 needed)"));
+      throw ra::InputError(
+          ra::located(file, line, "bicubic_patch with " + std::to_string(k) + " control points (16 needed)"));
     patches.push_back(p);
   }
   if (patches.empty()) throw ra::InputError(ra::located(file, 0, "no bicubic_patch found"));
@@ -140,12 +141,11 @@ void generate_teapot(const std::string& inc, const std::string& out_path, int st
   // (a 327 KB .inc at --steps 256 took 2.6 GB, a 32 MB one 16.8 GB).
   const double triangles = 2.0 * double(patches.size()) * steps * steps;
   if (triangles > kMaxTeapotTriangles)
-    throw ra::InputError(ra::located(inc, 0, std::to_string(patches.size()) + " patches at --steps " +
-                                                 std::to_string(steps) + " make " +
-                                                 std::to_string((long long)triangles) + " triangles (about " +
-                                                 std::to_string((long long)(triangles * 400 / 1e6)) +
-                                                 " MB); at most " + std::to_string((long long)kMaxTeapotTriangles) +
-                                                 ": a smaller --steps"));
+    throw ra::InputError(ra::located(inc, 0,
+                                     std::to_string(patches.size()) + " patches at --steps " + std::to_string(steps) +
+                                         " make " + std::to_string((long long)triangles) + " triangles (about " +
+                                         std::to_string((long long)(triangles * 400 / 1e6)) + " MB); at most " +
+                                         std::to_string((long long)kMaxTeapotTriangles) + ": a smaller --steps"));
   std::vector<Vec3d> positions;
   std::map<std::array<long long, 3>, int> weld;
   auto vertex = [&](const Vec3d& p) {
@@ -244,8 +244,8 @@ void generate_teapot(const std::string& inc, const std::string& out_path, int st
   // an existing teapot.obj for done, so an interrupted run must leave none.
   std::ostringstream out;
   out.precision(9);
-  out << "# Utah teapot: " << patches.size() << " Bezier patches of POV-Ray's teapot.inc, " << steps << "x"
-      << steps << " quads each (rayaudit generate teapot)\n";
+  out << "# Utah teapot: " << patches.size() << " Bezier patches of POV-Ray's teapot.inc, " << steps << "x" << steps
+      << " quads each (rayaudit generate teapot)\n";
   for (const auto& p : positions) out << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
   for (const auto& t : uvs) out << "vt " << t[0] << ' ' << t[1] << '\n';
   for (const auto& f : faces)
@@ -269,7 +269,7 @@ void generate_texture(const std::string& kind, const std::string& out, int n) {
       float* px = img.at(x, y);
       const double fx = (x + 0.5) / n, fy = (y + 0.5) / n;  // fy from the top
       if (kind == "uv-grid") {
-        const int cx = int(fx * 8), cy = int((1 - fy) * 8);  // cy counts from the bottom
+        const int cx = int(fx * 8), cy = int((1 - fy) * 8);                    // cy counts from the bottom
         const double lx = fx * 8 - cx, ly = (1 - fy) * 8 - int((1 - fy) * 8);  // in the cell, ly up
         const bool checker = (cx + cy) % 2 == 0;
         double r = 0.15 + 0.8 * (cx + 0.5) / 8, g = 0.15 + 0.8 * (cy + 0.5) / 8, b = checker ? 0.85 : 0.25;

@@ -48,8 +48,9 @@ std::vector<std::string> names_of(const std::vector<std::string>& given, const r
       const std::filesystem::path scenes = std::filesystem::weakly_canonical(set.root() / "scenes", ec);
       const std::filesystem::path under = std::filesystem::weakly_canonical(p, ec).lexically_relative(scenes);
       if (under.empty() || *under.begin() == "..")
-        throw ra::InputError(ra::located(g, 0, "not a scene under " + (set.root() / "scenes").string() +
-                                                   " (golden names scenes by their path there)"));
+        throw ra::InputError(ra::located(
+            g, 0,
+            "not a scene under " + (set.root() / "scenes").string() + " (golden names scenes by their path there)"));
       rel = under.generic_string();
     }
     // A scene named twice is checked once (its diff images would be two
@@ -103,19 +104,21 @@ void check_root(Args& a) {
 void check_diff_dir(const std::filesystem::path& diff_dir, const std::vector<std::string>& names,
                     const ra::GoldenSet& set) {
   if (const auto g = ra::golden_folder_of(diff_dir, set.root()))
-    throw ra::InputError(ra::located(diff_dir.string(), 0, "--diff-dir is in the golden folder " + g->string() +
-                                                               " (its images would be overwritten); give a folder "
-                                                               "outside every golden/"));
+    throw ra::InputError(ra::located(diff_dir.string(), 0,
+                                     "--diff-dir is in the golden folder " + g->string() +
+                                         " (its images would be overwritten); give a folder "
+                                         "outside every golden/"));
   std::set<std::filesystem::path> goldens;
   for (const auto& img : set.images()) goldens.insert(ra::real_path(img));
   for (const auto& n : names)
     for (const auto& out : ra::GoldenSet::diff_outputs(n, diff_dir)) {
       if (const auto g = ra::golden_folder_of(out, set.root()))
-        throw ra::InputError(ra::located(out.string(), 0, "would be written in the golden folder " + g->string() +
-                                                              " (--diff-dir " + diff_dir.string() + ")"));
+        throw ra::InputError(ra::located(
+            out.string(), 0,
+            "would be written in the golden folder " + g->string() + " (--diff-dir " + diff_dir.string() + ")"));
       if (goldens.count(ra::real_path(out)))
-        throw ra::InputError(ra::located(out.string(), 0, "is a golden image (--diff-dir " + diff_dir.string() +
-                                                              " would overwrite it)"));
+        throw ra::InputError(ra::located(
+            out.string(), 0, "is a golden image (--diff-dir " + diff_dir.string() + " would overwrite it)"));
     }
 }
 
@@ -137,8 +140,8 @@ void check(Args a) {
   ra::OutputBatch outputs({a.json, a.junit});
   const ra::GoldenSet set(a.root);
   ra::junit::Suite junit{"rayaudit golden check", {}};  // --junit: one test case per scene
-  const std::filesystem::path diff_dir =
-      a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden" : std::filesystem::path(a.diff_dir);
+  const std::filesystem::path diff_dir = a.diff_dir.empty() ? std::filesystem::temp_directory_path() / "rayaudit-golden"
+                                                            : std::filesystem::path(a.diff_dir);
   int failed = 0, skipped = 0;
   nlohmann::json rows = nlohmann::json::array();  // for --json (the report's golden section)
   const auto names = names_of(a.scenes, set);
@@ -196,7 +199,8 @@ void check(Args a) {
       if (std::filesystem::is_directory(out.parent_path(), ec)) {
         outputs.add(out);
       } else if (!later.insert(std::filesystem::absolute(out).lexically_normal()).second) {
-        throw ra::InputError(ra::located(out.string(), 0, "is named as two outputs of this command: one would be lost"));
+        throw ra::InputError(
+            ra::located(out.string(), 0, "is named as two outputs of this command: one would be lost"));
       }
     }
   auto before_write = [&](const std::filesystem::path& out) {
@@ -224,8 +228,8 @@ void check(Args a) {
     row["status"] = r.pass ? "ok" : "fail";
     row["message"] = r.message;
     rows.push_back(row);
-    junit.cases.push_back({"golden", n, r.pass ? ra::junit::Case::Status::pass : ra::junit::Case::Status::fail,
-                           r.message, r.message, 0});
+    junit.cases.push_back(
+        {"golden", n, r.pass ? ra::junit::Case::Status::pass : ra::junit::Case::Status::fail, r.message, r.message, 0});
     failed += !r.pass;
   }
   // Written whatever the verdict: a failed check is what the report must show.
@@ -242,8 +246,7 @@ void check(Args a) {
   if (!a.junit.empty()) ra::junit::write(a.junit, {junit});
   outputs.commit();  // the JSON and the diff images
   if (failed)
-    throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) +
-                          " golden image(s) failed");
+    throw ra::CheckFailed(std::to_string(failed) + " of " + std::to_string(names.size()) + " golden image(s) failed");
   if (skipped == int(names.size())) throw ra::cli::ExitCode{77};
 }
 

@@ -34,8 +34,9 @@ void setup(CLI::App& app) {
     std::string ext = std::filesystem::path(o->file).extension().string();
     for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     if (ext == ".ply" || ext == ".off" || ext == ".json")
-      throw ra::InputError(ra::located(o->file, 0, "a " + ext.substr(1) + " file: info reads OBJ meshes" +
-                                                       (ext == ".json" ? std::string() : " (rayaudit convert it to OBJ first)")));
+      throw ra::InputError(ra::located(o->file, 0,
+                                       "a " + ext.substr(1) + " file: info reads OBJ meshes" +
+                                           (ext == ".json" ? std::string() : " (rayaudit convert it to OBJ first)")));
     const ra::Mesh m = ra::load_obj(o->file, opt);
     const ra::Bounds3d b = m.bbox();
     auto vec = [](const ra::Vec3d& v) { return nlohmann::json::array({v.x, v.y, v.z}); };

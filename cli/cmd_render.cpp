@@ -77,18 +77,22 @@ void run(const Args& a) {
   for (const auto& name : a.methods) {
     const ra::Method* m = ra::find_method(name);
     if (!m || m->kind == ra::Kind::plane)
-      throw ra::InputError("unknown method \"" + name + "\" for --method; triangle methods: " +
-                           ra::method_names(ra::Kind::triangle) +
+      throw ra::InputError("unknown method \"" + name +
+                           "\" for --method; triangle methods: " + ra::method_names(ra::Kind::triangle) +
                            "; sphere methods: " + ra::method_names(ra::Kind::sphere));
     const ra::Method*& slot = m->kind == ra::Kind::triangle ? chosen_triangle : chosen_sphere;
     if (slot && slot != m)
       throw ra::InputError("--method given two " + std::string(m->kind == ra::Kind::triangle ? "triangle" : "sphere") +
-                           " methods (\"" + std::string(slot->name) + "\" and \"" + name + "\"); give one of each kind");
+                           " methods (\"" + std::string(slot->name) + "\" and \"" + name +
+                           "\"); give one of each kind");
     slot = m;
-    if (m->kind == ra::Kind::triangle) opt.triangle_method = name;
-    else opt.sphere_method = name;
+    if (m->kind == ra::Kind::triangle)
+      opt.triangle_method = name;
+    else
+      opt.sphere_method = name;
   }
-  if (a.precision == "float") opt.use_double = false;
+  if (a.precision == "float")
+    opt.use_double = false;
   else if (a.precision != "double")
     throw ra::InputError("--precision must be float or double, got \"" + a.precision + "\"");
   auto accel = ra::parse_accel(a.accel);
@@ -96,8 +100,8 @@ void run(const Args& a) {
   opt.accel = *accel;
   auto si = ra::parse_self_intersection(a.self_intersection);
   if (!si)
-    throw ra::InputError("--self-intersection must be one of " + std::string(ra::kSelfIntersectionNames) +
-                         ", got \"" + a.self_intersection + "\"");
+    throw ra::InputError("--self-intersection must be one of " + std::string(ra::kSelfIntersectionNames) + ", got \"" +
+                         a.self_intersection + "\"");
   opt.self_intersection = *si;
   opt.cull = a.cull;
   opt.threads = a.threads;
@@ -159,7 +163,8 @@ void setup(CLI::App& app) {
       ->allow_extra_args(false);  // one name per --method: `--method kraus SCENE` keeps SCENE
   cmd->add_option("--precision", args->precision, "Intersection precision: float or double (default double)");
   cmd->add_flag("--cull", args->cull, "Backface culling of triangles");
-  cmd->add_option("--accel", args->accel, "Acceleration: bvh (default), sphere (document 002's bounding sphere) or none");
+  cmd->add_option("--accel", args->accel,
+                  "Acceleration: bvh (default), sphere (document 002's bounding sphere) or none");
   cmd->add_option("--self-intersection", args->self_intersection,
                   "Secondary-ray strategy: eps, pov (default), normal-offset, ulp-offset");
   cmd->add_option("--bits", args->bits, "PNG bits per channel: 8 or 16 (default 8)");

@@ -57,8 +57,10 @@ std::string gbench_non_finite_to_null(const std::string& in) {
     const char c = in[i];
     if (str) {
       out += c;
-      if (c == '\\' && i + 1 < in.size()) out += in[++i];
-      else if (c == '"') str = false;
+      if (c == '\\' && i + 1 < in.size())
+        out += in[++i];
+      else if (c == '"')
+        str = false;
       continue;
     }
     if (c == '"') str = true;
@@ -97,9 +99,13 @@ const json& need(const fs::path& f, const json& j, const std::string& where, con
   if (!j.is_object() || !j.contains(key))
     throw ra::InputError(f.string() + ": " + (where.empty() ? "" : where + ": ") + "missing '" + key + "'");
   const json& v = j.at(key);
-  const bool ok = type == "object" ? v.is_object() : type == "array" ? v.is_array()
-                : type == "number" ? v.is_number() : type == "string" ? v.is_string() : v.is_boolean();
-  if (!ok) throw ra::InputError(f.string() + ": " + (where.empty() ? "" : where + ": ") + "'" + key + "' is not a " + type);
+  const bool ok = type == "object"   ? v.is_object()
+                  : type == "array"  ? v.is_array()
+                  : type == "number" ? v.is_number()
+                  : type == "string" ? v.is_string()
+                                     : v.is_boolean();
+  if (!ok)
+    throw ra::InputError(f.string() + ": " + (where.empty() ? "" : where + ": ") + "'" + key + "' is not a " + type);
   return v;
 }
 
@@ -107,7 +113,8 @@ json check_audit(const fs::path& f) {
   json j = read_json(f);
   if (!j.is_object()) throw ra::InputError(f.string() + ": not an audit JSON (rayaudit audit --json): not an object");
   if (j.contains("cases") && !j.contains("subjects"))
-    throw ra::InputError(f.string() + ": an `audit --cases` output; the report needs the families' audit (rayaudit audit --json)");
+    throw ra::InputError(f.string() +
+                         ": an `audit --cases` output; the report needs the families' audit (rayaudit audit --json)");
   need(f, j, "", "seed", "number");
   need(f, j, "", "rays_per_family", "number");
   const json& subs = need(f, j, "", "subjects", "array");
@@ -146,7 +153,8 @@ void check_audits(const std::vector<std::string>& files) {
   std::map<std::string, std::string> owner;
   for (const auto& f : files) {
     const json j = check_audit(f);
-    if (first.is_null()) first = j;
+    if (first.is_null())
+      first = j;
     else
       for (const char* k : {"seed", "rays_per_family"})
         if (j[k] != first[k])
@@ -172,7 +180,8 @@ void check_timings(const fs::path& f) {
     ++n;
     if (line.empty() || line[0] == '#') continue;
     if (header) {
-      if (line != "subject,ns_per_test") throw ra::InputError(ra::located(f.string(), n, "expected the header subject,ns_per_test"));
+      if (line != "subject,ns_per_test")
+        throw ra::InputError(ra::located(f.string(), n, "expected the header subject,ns_per_test"));
       header = false;
       continue;
     }
@@ -184,7 +193,8 @@ void check_timings(const fs::path& f) {
     char* end = nullptr;
     const std::string num = line.substr(comma + 1);
     const double v = std::strtod(num.c_str(), &end);
-    if (num.empty() || num.find_first_not_of("0123456789.eE+-") != std::string::npos || *end || !std::isfinite(v) || v <= 0)
+    if (num.empty() || num.find_first_not_of("0123456789.eE+-") != std::string::npos || *end || !std::isfinite(v) ||
+        v <= 0)
       throw ra::InputError(ra::located(f.string(), n, "ns_per_test '" + num + "' is not a positive number"));
   }
 }
@@ -205,8 +215,7 @@ void check_bench(const fs::path& f) {
     for (const char* k : {"ns_per_test", "Mrays_per_s", "ratio", "triangles"}) {
       if (!bs[i].contains(k) || (spread && bs[i][k].is_null())) continue;
       const json& v = bs[i][k];
-      if (v.is_null())
-        throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is NaN or infinite");
+      if (v.is_null()) throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is NaN or infinite");
       if (!v.is_number()) throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is not a number");
       if (!(v.get<double>() >= 0))
         throw ra::InputError(f.string() + ": " + at + ": '" + k + "' is negative (" + v.dump() + ")");
@@ -215,7 +224,8 @@ void check_bench(const fs::path& f) {
 }
 
 void check_compare_dir(const fs::path& d) {
-  if (!fs::is_directory(d)) throw ra::InputError(d.string() + ": not a directory (--compare takes a directory of `compare --json` outputs)");
+  if (!fs::is_directory(d))
+    throw ra::InputError(d.string() + ": not a directory (--compare takes a directory of `compare --json` outputs)");
   int found = 0;
   for (const auto& e : fs::directory_iterator(d)) {
     if (e.path().extension() != ".json") continue;
@@ -224,7 +234,8 @@ void check_compare_dir(const fs::path& d) {
     need(e.path(), j, "", "identical", "boolean");
     const json& ds = need(e.path(), j, "", "differences", "array");
     for (std::size_t i = 0; i < ds.size(); ++i)
-      for (const char* k : {"x", "y", "levels"}) need(e.path(), ds[i], "differences[" + std::to_string(i) + "]", k, "number");
+      for (const char* k : {"x", "y", "levels"})
+        need(e.path(), ds[i], "differences[" + std::to_string(i) + "]", k, "number");
     if (j.contains("explanations")) {
       const json& ex = need(e.path(), j, "", "explanations", "array");
       for (std::size_t i = 0; i < ex.size(); ++i) {
@@ -235,11 +246,14 @@ void check_compare_dir(const fs::path& d) {
     }
     ++found;
   }
-  if (!found) throw ra::InputError(d.string() + ": no compare JSON in this directory (rayaudit compare SCENE --json DIR/NAME.json)");
+  if (!found)
+    throw ra::InputError(d.string() +
+                         ": no compare JSON in this directory (rayaudit compare SCENE --json DIR/NAME.json)");
 }
 
 void check_crack_maps(const fs::path& d) {
-  if (!fs::is_directory(d)) throw ra::InputError(d.string() + ": not a directory (--crack-maps takes `rayaudit crack-maps -o DIR`'s DIR)");
+  if (!fs::is_directory(d))
+    throw ra::InputError(d.string() + ": not a directory (--crack-maps takes `rayaudit crack-maps -o DIR`'s DIR)");
   const fs::path f = d / "crack_maps.json";
   const json j = read_json(f);
   need(f, j, "", "legend", "string");
@@ -252,9 +266,11 @@ void check_crack_maps(const fs::path& d) {
   for (std::size_t i = 0; i < maps.size(); ++i) {
     const std::string at = "maps[" + std::to_string(i) + "]";
     for (const char* k : {"mesh", "method", "precision", "image"}) need(f, maps[i], at, k, "string");
-    for (const char* k : {"offset", "pixels", "surface_pixels", "leaks", "false_hits"}) need(f, maps[i], at, k, "number");
+    for (const char* k : {"offset", "pixels", "surface_pixels", "leaks", "false_hits"})
+      need(f, maps[i], at, k, "number");
     const fs::path img = d / maps[i]["image"].get<std::string>();
-    if (!fs::is_regular_file(img)) throw ra::InputError(f.string() + ": " + at + ": image " + img.string() + " is missing");
+    if (!fs::is_regular_file(img))
+      throw ra::InputError(f.string() + ": " + at + ": image " + img.string() + " is missing");
   }
 }
 
@@ -262,7 +278,8 @@ void check_golden(const fs::path& f) {
   const json j = read_json(f);
   const json& ss = need(f, j, "", "scenes", "array");
   for (std::size_t i = 0; i < ss.size(); ++i)
-    for (const char* k : {"name", "status", "message"}) need(f, ss[i], "scenes[" + std::to_string(i) + "]", k, "string");
+    for (const char* k : {"name", "status", "message"})
+      need(f, ss[i], "scenes[" + std::to_string(i) + "]", k, "string");
 }
 
 // ci/main.sh's stage timings: one "NAME<TAB>SECONDS" a line.
@@ -283,7 +300,8 @@ void check_stages(const fs::path& f) {
     // Decimal only: strtod also takes C99 hex ("0x10"), which the page's
     // Python float() refuses.
     if (line.find_first_not_of("0123456789.eE+-", tab + 1) != std::string::npos)
-      throw ra::InputError(ra::located(f.string(), n, "seconds '" + line.substr(tab + 1, 40) + "' is not a decimal number"));
+      throw ra::InputError(
+          ra::located(f.string(), n, "seconds '" + line.substr(tab + 1, 40) + "' is not a decimal number"));
     // nan, a negative time or 1e400 (inf) were drawn as given.
     if (!std::isfinite(seconds) || seconds < 0)
       throw ra::InputError(ra::located(f.string(), n, "seconds must be a finite number >= 0"));
@@ -293,8 +311,11 @@ void check_stages(const fs::path& f) {
 json methods_json() {
   json out = json::array();
   for (const auto& m : ra::methods())
-    out.push_back({{"name", m.name}, {"kind", std::string(ra::kind_name(m.kind))}, {"source", m.source},
-                   {"description", m.description}, {"wrong_on_purpose", m.wrong_on_purpose}});
+    out.push_back({{"name", m.name},
+                   {"kind", std::string(ra::kind_name(m.kind))},
+                   {"source", m.source},
+                   {"description", m.description},
+                   {"wrong_on_purpose", m.wrong_on_purpose}});
   return out;
 }
 
@@ -368,30 +389,32 @@ void run(const Args& a) {
   json audits = json::array(), audits_hex = json::array();
   for (const auto& f : a.audits) audits.push_back(absolute(f)), audits_hex.push_back(hex_bytes(absolute(f)));
   json ctx = {{"audit", a.audit.empty() ? json(nullptr) : json(absolute(a.audit))},
-                    {"audits", audits},
-                    {"timings", a.timings.empty() ? json(nullptr) : json(absolute(a.timings))},
-                    {"bench", benches},
-                    {"compare", compare},
-                    {"crack_maps", a.crack_maps.empty() ? json(nullptr) : json(absolute(a.crack_maps))},
-                    {"golden", a.golden.empty() ? json(nullptr) : json(absolute(a.golden))},
-                    {"stages", a.stages.empty() ? json(nullptr) : json(absolute(a.stages))},
-                    {"methods", methods_json()},
-                    {"source_dir", RAYAUDIT_SOURCE_DIR},
-                    {"build",
-                     {{"compiler", RAYAUDIT_COMPILER},
-                      {"flags", RAYAUDIT_CXX_FLAGS},
-                      {"build_type", RAYAUDIT_BUILD_TYPE},
-                      {"version", std::string("rayaudit ") + RAYAUDIT_VERSION}}},
-                    {"out_dir", tmp.string()}};
+              {"audits", audits},
+              {"timings", a.timings.empty() ? json(nullptr) : json(absolute(a.timings))},
+              {"bench", benches},
+              {"compare", compare},
+              {"crack_maps", a.crack_maps.empty() ? json(nullptr) : json(absolute(a.crack_maps))},
+              {"golden", a.golden.empty() ? json(nullptr) : json(absolute(a.golden))},
+              {"stages", a.stages.empty() ? json(nullptr) : json(absolute(a.stages))},
+              {"methods", methods_json()},
+              {"source_dir", RAYAUDIT_SOURCE_DIR},
+              {"build",
+               {{"compiler", RAYAUDIT_COMPILER},
+                {"flags", RAYAUDIT_CXX_FLAGS},
+                {"build_type", RAYAUDIT_BUILD_TYPE},
+                {"version", std::string("rayaudit ") + RAYAUDIT_VERSION}}},
+              {"out_dir", tmp.string()}};
   // JSON strings are UTF-8, file names are bytes: the paths again, as hex
   // of their bytes, which the script decodes with os.fsdecode
   // (a Latin-1 directory name could not be opened from the context).
   json fs_paths = json::object();
   for (const char* k : {"audit", "crack_maps", "golden", "stages", "out_dir"})
-    if (ctx.at(k).is_string()) fs_paths[k] = hex_bytes(k == std::string("out_dir") ? tmp.string() :
-                                                      k == std::string("audit") ? absolute(a.audit) :
-                                                      k == std::string("crack_maps") ? absolute(a.crack_maps) :
-                                                      k == std::string("golden") ? absolute(a.golden) : absolute(a.stages));
+    if (ctx.at(k).is_string())
+      fs_paths[k] = hex_bytes(k == std::string("out_dir")      ? tmp.string()
+                              : k == std::string("audit")      ? absolute(a.audit)
+                              : k == std::string("crack_maps") ? absolute(a.crack_maps)
+                              : k == std::string("golden")     ? absolute(a.golden)
+                                                               : absolute(a.stages));
   json cmp_hex = json::array();
   for (const auto& d : a.compare) cmp_hex.push_back(hex_bytes(absolute(d)));
   fs_paths["compare"] = cmp_hex;

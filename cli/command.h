@@ -13,7 +13,9 @@ namespace ra::cli {
 // `setup` adds a subcommand to the app and its callback. The callback may
 // throw ra::InputError (exit 2) or ra::CheckFailed (exit 1), or return an
 // exit code by throwing ExitCode.
-struct ExitCode { int code; };
+struct ExitCode {
+  int code;
+};
 
 struct Command {
   int order;  // position in --help
@@ -46,14 +48,14 @@ inline std::vector<std::string> split_list(const std::string& s, const char* fla
 // explicit `--families ''` meant every family).
 inline CLI::Validator non_empty_list() {
   return CLI::Validator(
-      [](std::string& v) { return v.find_first_not_of(' ') == std::string::npos ? std::string("empty list") : std::string(); },
+      [](std::string& v) {
+        return v.find_first_not_of(' ') == std::string::npos ? std::string("empty list") : std::string();
+      },
       "LIST");
 }
 
 struct Registrar {
-  Registrar(int order, std::function<void(CLI::App&)> setup) {
-    commands().push_back({order, std::move(setup)});
-  }
+  Registrar(int order, std::function<void(CLI::App&)> setup) { commands().push_back({order, std::move(setup)}); }
 };
 
 }  // namespace ra::cli

@@ -134,7 +134,8 @@ TEST(FetchCorpus, KilledPartWayThenRerunEndsWithTheSameCacheAsAnUninterruptedFet
   EXPECT_FALSE(any_path_ends_with(cache / "corpus", "dragon.ply.tmp")) << "the dragon's PLY was left behind";
   for (const char* dir : {"ladder", "generated"})
     for (const auto& e : fs::directory_iterator(cache / "corpus" / dir))
-      EXPECT_NE(e.path().filename().string().rfind(".tmp-", 0), 0u) << "a killed rayaudit's temporary was left: " << e.path();
+      EXPECT_NE(e.path().filename().string().rfind(".tmp-", 0), 0u)
+          << "a killed rayaudit's temporary was left: " << e.path();
 
   const auto want = listing(reference), got = listing(cache / "corpus");
   ASSERT_FALSE(want.empty());

@@ -88,8 +88,8 @@ TEST_F(GoldenDataCli, EmptyDiffDirOrJsonIsRefused) {
 // --diff-dir it creates, with a folder for a scene name that holds one.
 TEST_F(GoldenDataCli, FailingCheckWritesItsDiffImagesIntoANewDirectory) {
   const fs::path out = root / "new" / "diffs";
-  const auto r = run_rayaudit("golden check a b --root " + root.string() + " --diff-dir " + out.string() +
-                              " --json " + (root / "g.json").string());
+  const auto r = run_rayaudit("golden check a b --root " + root.string() + " --diff-dir " + out.string() + " --json " +
+                              (root / "g.json").string());
   EXPECT_EQ(r.code, 1) << r.all;
   EXPECT_TRUE(fs::exists(out / "a.diff.png"));
   EXPECT_TRUE(fs::exists(out / "a.png"));
@@ -100,7 +100,8 @@ TEST_F(GoldenDataCli, FailingCheckWritesItsDiffImagesIntoANewDirectory) {
 // A scene that fails to load after a failing one: exit 2 and none of the
 // first one's diff images (outputs are renamed together at the end).
 TEST_F(GoldenDataCli, CheckEndingInABadSceneWritesNothing) {
-  std::ofstream(root / "scenes" / "b.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})" << "\n";
+  std::ofstream(root / "scenes" / "b.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})"
+                                            << "\n";
   fs::create_directories(root / "out");
   const auto r = run_rayaudit("golden check a b --root " + root.string() + " --diff-dir " + (root / "out").string());
   EXPECT_EQ(r.code, 2) << r.all;
@@ -124,7 +125,8 @@ TEST_F(GoldenDataCli, UnknownSceneIsRefusedBeforeTheWork) {
 // The same into a diff folder that is not there yet: the check makes it for
 // a's images, then exits 2 on b; the new folders are removed again.
 TEST_F(GoldenDataCli, CheckEndingInABadSceneLeavesNoNewDiffFolder) {
-  std::ofstream(root / "scenes" / "b.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})" << "\n";
+  std::ofstream(root / "scenes" / "b.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})"
+                                            << "\n";
   const fs::path out = root / "made" / "diffs";
   const auto r = run_rayaudit("golden check a b --root " + root.string() + " --diff-dir " + out.string());
   EXPECT_EQ(r.code, 2) << r.all;
@@ -135,7 +137,8 @@ TEST_F(GoldenDataCli, CheckEndingInABadSceneLeavesNoNewDiffFolder) {
 // `bless a BAD` rewrote a's golden, then failed on BAD: image and
 // manifest disagreed. Now every scene is rendered before anything is written.
 TEST_F(GoldenDataCli, BlessOfAGoodAndABadSceneWritesNothing) {
-  std::ofstream(root / "scenes" / "z.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})" << "\n";
+  std::ofstream(root / "scenes" / "z.json") << R"({"objects": [{"mesh": "nosuch.obj"}]})"
+                                            << "\n";
   const auto r = run_rayaudit("golden bless a z --root " + root.string());
   EXPECT_EQ(r.code, 2) << r.all;
   EXPECT_TRUE(one_line(r.err)) << r.err;
@@ -231,7 +234,7 @@ fs::path sphere_repo(const std::string& name) {
   fs::create_directories(root / "scenes");
   fs::create_directories(root / "golden");
   std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 1}}]})"
-                                             << "\n";
+                                            << "\n";
   return root;
 }
 
@@ -295,7 +298,7 @@ TEST(GoldenCli, GoldenOutputsNeverReplaceInputsAndBlessIsAllOrNothing) {
   ASSERT_EQ(run_rayaudit("golden bless t --root " + root.string()).code, 0);
   // A golden that differs from the render: a check fails and writes its images.
   std::ofstream(root / "scenes" / "t.json") << R"({"width": 8, "height": 8, "objects": [{"sphere": {"radius": 0.5}}]})"
-                                             << "\n";
+                                            << "\n";
   const std::string golden = slurp(root / "golden" / "t.png"), manifest = slurp(root / "golden" / "manifest.json");
   auto r = run_rayaudit("golden check t --root " + root.string() + " --diff-dir " + (root / "golden").string());
   EXPECT_EQ(r.code, 2) << r.all;
@@ -310,7 +313,8 @@ TEST(GoldenCli, GoldenOutputsNeverReplaceInputsAndBlessIsAllOrNothing) {
   EXPECT_NE(r.err.find("is named as two outputs of this command"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::is_empty(root / "out"));
 
-  std::ofstream(root / "scenes" / "zbad.json") << R"({"objects": [{"mesh": "meshes/nosuch.obj"}]})" << "\n";
+  std::ofstream(root / "scenes" / "zbad.json") << R"({"objects": [{"mesh": "meshes/nosuch.obj"}]})"
+                                               << "\n";
   r = run_rayaudit("golden bless t zbad --root " + root.string());
   EXPECT_EQ(r.code, 2) << r.all;
   EXPECT_NE(r.err.find("zbad.json: /objects/0/mesh: file not found"), std::string::npos) << r.err;

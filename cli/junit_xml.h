@@ -24,7 +24,8 @@ inline JUnitRead read_junit(const std::string& path) {
       "    assert int(s.get('failures')) == sum(c.find('failure') is not None for c in cases)\n"
       "for c in root.iter('testcase'):\n"
       "    f, k = c.find('failure'), c.find('skipped')\n"
-      "    v = 'FAIL: ' + f.get('message') if f is not None else ('SKIP: ' + k.get('message') if k is not None else 'ok')\n"
+      "    v = 'FAIL: ' + f.get('message') if f is not None else ('SKIP: ' + k.get('message') if k is not None else "
+      "'ok')\n"
       "    print(c.get('classname') + '|' + c.get('name') + '|' + v.replace('\\n', ' '))\n";
   const std::string cmd = "/usr/bin/python3 -c \"$RA_JUNIT_SCRIPT\" '" + path + "' 2>&1";
   ::setenv("RA_JUNIT_SCRIPT", script.c_str(), 1);

@@ -26,7 +26,9 @@ namespace {
 // option that takes a value (and every positional) refuses "" by name.
 void refuse_empty_values(CLI::App& app) {
   const CLI::Validator non_empty(
-      [](std::string& v) { return v.empty() ? std::string("empty value (a file name or value is needed)") : std::string(); },
+      [](std::string& v) {
+        return v.empty() ? std::string("empty value (a file name or value is needed)") : std::string();
+      },
       "", "NON_EMPTY");
   for (CLI::Option* opt : app.get_options())
     if (opt->get_type_size_max() > 0) opt->check(non_empty);

@@ -46,8 +46,8 @@ const std::string kSphereOnPlane = std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/s
 
 TEST(ExportPovCli, WritesSdlWithTheCameraAndEveryFinishTerm) {
   const fs::path dir = temp_dir("export");
-  const Result r = run("export-pov " + kSphereOnPlane + " -o " + (dir / "s.pov").string() + " --ini " +
-                       (dir / "s.ini").string());
+  const Result r =
+      run("export-pov " + kSphereOnPlane + " -o " + (dir / "s.pov").string() + " --ini " + (dir / "s.ini").string());
   ASSERT_EQ(r.code, 0) << r.out;
   const std::string sdl = read(dir / "s.pov");
   EXPECT_NE(sdl.find("right <-1.3333333333333333,0,0>"), std::string::npos) << sdl;
@@ -88,7 +88,9 @@ TEST(ExportPovCli, HostileTextureNameInASceneFileCannotInjectSdl) {
   fs::create_directories((dir / name).parent_path());
   fs::copy_file(std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/textures/uv-grid.png", dir / name);
   fs::copy_file(std::string(RAYAUDIT_SOURCE_DIR) + "/scenes/meshes/quad.obj", dir / "quad.obj");
-  nlohmann::json scene = {{"width", 48}, {"height", 36}, {"camera", {{"position", {0, 0, 3}}}},
+  nlohmann::json scene = {{"width", 48},
+                          {"height", 36},
+                          {"camera", {{"position", {0, 0, 3}}}},
                           {"objects", {{{"mesh", "quad.obj"}, {"material", {{"texture", {{"file", name}}}}}}}}};
   std::ofstream(dir / "s.json") << scene.dump();
   Result r = run("export-pov " + (dir / "s.json").string() + " -o " + (dir / "out.pov").string());
@@ -209,8 +211,12 @@ TEST(GoldenCli, CheckWithoutAGoldenFailsAndBlessRecordsOne) {
 // compare --random: bad flags are one line and exit 2, nothing written.
 TEST(CompareRandomCli, RefusesBadFlagsWithOneLine) {
   const fs::path dir = temp_dir("random-bad") / "out";
-  const std::vector<std::string> cases = {"--random 0", "--random 2 --seed -1", "--random 2 --json /tmp/x.json",
-                                         kSphereOnPlane + " --random 2", kSphereOnPlane + " --seed 3", kSphereOnPlane};
+  const std::vector<std::string> cases = {"--random 0",
+                                          "--random 2 --seed -1",
+                                          "--random 2 --json /tmp/x.json",
+                                          kSphereOnPlane + " --random 2",
+                                          kSphereOnPlane + " --seed 3",
+                                          kSphereOnPlane};
   for (const std::string& args : cases) {
     const auto r = ra::test::run_rayaudit("compare " + args + " --out " + dir.string());
     EXPECT_EQ(r.code, 2) << args << ": " << r.all;
@@ -268,8 +274,8 @@ TEST(CompareRandomCliSlow, UnexplainedPixelExits1AndWritesAMinimalScene) {
                                             "RAYAUDIT_EXPLAIN_SKIP='" + all_causes + "'");
   EXPECT_EQ(again.code, 1) << again.all;
   // (its difference may have grown: the shrink keeps the pixel, not its size)
-  const std::string at = "  (" + std::to_string(list[0]["x"].get<int>()) + ", " +
-                         std::to_string(list[0]["y"].get<int>()) + ") ";
+  const std::string at =
+      "  (" + std::to_string(list[0]["x"].get<int>()) + ", " + std::to_string(list[0]["y"].get<int>()) + ") ";
   const auto line_at = again.out.find(at);
   ASSERT_NE(line_at, std::string::npos) << again.all;
   const std::string line = again.out.substr(line_at, again.out.find('\n', line_at) - line_at);
@@ -312,7 +318,6 @@ int processes_in(const fs::path& dir, pid_t parent = 0) {
   }
   return n;
 }
-
 
 // An interrupted compare left POV-Ray running as an orphan and its
 // working directory in /tmp. Now the signal kills POV-Ray, removes the

@@ -49,8 +49,8 @@ TEST(RenderLimitsCli, AHugePathIsNotQuotedWhole) {
   const auto r = run_rayaudit("render " + scene.string() + " -o " + scratch("o.png").string());
   EXPECT_EQ(r.code, 2) << r.err.substr(0, 300);
   EXPECT_TRUE(one_line(r.err)) << r.err.substr(0, 300);
-  EXPECT_EQ(r.err, scene.string() +
-                       ": /objects/0/mesh: a path of 1048580 bytes, longer than a path can be (4095 bytes)\n");
+  EXPECT_EQ(r.err,
+            scene.string() + ": /objects/0/mesh: a path of 1048580 bytes, longer than a path can be (4095 bytes)\n");
 }
 
 // One mesh placed 400 times was loaded and given a BVH 400 times (a
@@ -96,8 +96,8 @@ TEST(RenderLimitsCli, TenThousandSpheresAreBoundedByTheObjectBvh) {
     out << "]}\n";
   }
   const fs::path png = scratch("sp10k.png");
-  const auto r = run_rayaudit("render " + scene.string() + " -o " + png.string() + " --threads 1",
-                              "prlimit --cpu=20 --");
+  const auto r =
+      run_rayaudit("render " + scene.string() + " -o " + png.string() + " --threads 1", "prlimit --cpu=20 --");
   EXPECT_EQ(r.code, 0) << r.all;
   EXPECT_TRUE(fs::exists(png));
 }
@@ -196,9 +196,9 @@ TEST(RenderLimitsCli, Texture16384OneBitLoadsInItsOwnBytesOrIsRefusedUpFront) {
 TEST(RenderLimitsCli, ImageModuleUnderALowAddressSpaceLimitIsOneLine) {
   RAYAUDIT_SKIP_IF_SANITIZED();
   for (const char* limit : {"300000000", "410000000", "430000000", "450000000", "500000000"}) {
-    const auto r = run_rayaudit("render " + kScenes + "/bump-height.json --width 8 --height 8 -o " +
-                                    scratch("lowas.png").string(),
-                                std::string("prlimit --as=") + limit + " --");
+    const auto r =
+        run_rayaudit("render " + kScenes + "/bump-height.json --width 8 --height 8 -o " + scratch("lowas.png").string(),
+                     std::string("prlimit --as=") + limit + " --");
     EXPECT_EQ(r.code, 2) << limit << "\n" << r.all;
     EXPECT_TRUE(one_line(r.err)) << limit << "\n" << r.err;
     EXPECT_EQ(r.err.rfind("rayaudit_image.so: ", 0), 0u) << r.err;
@@ -211,9 +211,9 @@ TEST(RenderLimitsCli, ImageModuleUnderALowAddressSpaceLimitIsOneLine) {
 TEST(RenderLimitsCli, RenderBeyondTheMemoryLimitIsRefusedWithAnEstimate) {
   RAYAUDIT_SKIP_IF_SANITIZED();
   const fs::path out = scratch("huge.png");
-  const auto r = run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 -o " +
-                                  out.string(),
-                              "prlimit --as=2000000000 --");
+  const auto r =
+      run_rayaudit("render " + kScenes + "/doc000-pyramid.json --width 16384 --height 16384 -o " + out.string(),
+                   "prlimit --as=2000000000 --");
   EXPECT_EQ(r.code, 2) << r.all;
   EXPECT_TRUE(one_line(r.err)) << r.err;
   EXPECT_EQ(r.err.rfind("render: 16384x16384 needs about 6144 MB for its image buffers, but only ", 0), 0u) << r.err;

@@ -52,9 +52,9 @@ TEST(ReportBrowser, RealSmallRunOpensInChromiumWithEverythingDrawn) {
                    "/scenes/meshes/tetrahedron.obj");
   ASSERT_EQ(r.code, 0) << r.all;
   const std::string scene = RAYAUDIT_SOURCE_DIR "/scenes/doc000-pyramid.json";
-  r = run_rayaudit("compare " + scene + " --width 80 --height 60 --explain --json " + (d / "pov/pyramid.json").string() +
-                   " --diff " + (d / "pov/pyramid-diff.png").string() + " --ours " + (d / "pov/pyramid-ours.png").string() +
-                   " --pov " + (d / "pov/pyramid-pov.png").string());
+  r = run_rayaudit("compare " + scene + " --width 80 --height 60 --explain --json " +
+                   (d / "pov/pyramid.json").string() + " --diff " + (d / "pov/pyramid-diff.png").string() + " --ours " +
+                   (d / "pov/pyramid-ours.png").string() + " --pov " + (d / "pov/pyramid-pov.png").string());
   ASSERT_TRUE(r.code == 0 || r.code == 1) << r.all;  // a difference beyond tolerance is still a report
   r = run_rayaudit("golden check doc000-pyramid --json " + (d / "golden.json").string() + " --diff-dir " +
                    (d / "golden-diffs").string());
@@ -72,9 +72,10 @@ TEST(ReportBrowser, RealSmallRunOpensInChromiumWithEverythingDrawn) {
   const bool corpus = fs::exists(ra::cache_dir() / "corpus" / "ladder" / "box.obj");
   std::string bench_arg;
   if (corpus) {
-    r = run_rayaudit("bench --quick --benchmark_repetitions=1 --json " + (d / "bench.json").string() +
-                     " --filter '^(kernel/(moller|watertight)/(float|double)/nocull/hit=50/back=0"
-                     "|scene/box/(none|sphere|bvh)/(cull|nocull)/primary/threads=1|peer/tinyobjloader/bunny_glmark2)$'");
+    r = run_rayaudit(
+        "bench --quick --benchmark_repetitions=1 --json " + (d / "bench.json").string() +
+        " --filter '^(kernel/(moller|watertight)/(float|double)/nocull/hit=50/back=0"
+        "|scene/box/(none|sphere|bvh)/(cull|nocull)/primary/threads=1|peer/tinyobjloader/bunny_glmark2)$'");
     ASSERT_EQ(r.code, 0) << r.all;
     bench_arg = " --bench " + (d / "bench.json").string();
   }
@@ -130,14 +131,15 @@ TEST(ReportBrowser, RealSmallRunOpensInChromiumWithEverythingDrawn) {
   const std::size_t console = dom.find("CONSOLE");
   if (console != std::string::npos) {
     const std::size_t from = dom.rfind('\n', console), to = dom.find('\n', console);
-    ADD_FAILURE() << dom.substr(from == std::string::npos ? 0 : from + 1, to == std::string::npos ? std::string::npos : to - from);
+    ADD_FAILURE() << dom.substr(from == std::string::npos ? 0 : from + 1,
+                                to == std::string::npos ? std::string::npos : to - from);
   }
   EXPECT_EQ(dom.find("Uncaught"), std::string::npos);
 
   const fs::path shot = d / "report" / "screenshot.png";
   std::string log;
-  rc = sh("cd " + d.string() + " && " + chromium(profile) + " --hide-scrollbars --window-size=1280,2400 --screenshot=" +
-              shot.string() + " file://" + page.string(),
+  rc = sh("cd " + d.string() + " && " + chromium(profile) +
+              " --hide-scrollbars --window-size=1280,2400 --screenshot=" + shot.string() + " file://" + page.string(),
           log);
   ASSERT_EQ(rc, 0) << log;
   ASSERT_TRUE(fs::exists(shot)) << log;

@@ -31,8 +31,8 @@ int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n'
 // A genuine audit output, small (two methods, two families).
 fs::path small_audit(const fs::path& dir) {
   const fs::path a = dir / "audit.json";
-  const auto r = run_rayaudit("audit --methods moller,watertight --families edge,closed-mesh --rays 600 --json " +
-                              a.string());
+  const auto r =
+      run_rayaudit("audit --methods moller,watertight --families edge,closed-mesh --rays 600 --json " + a.string());
   EXPECT_EQ(r.code, 0) << r.all;
   return a;
 }
@@ -181,8 +181,8 @@ TEST(GoldenJson, RowPerSceneWithStatusAlsoOnFailure) {
 
 TEST(CrackMapsCli, BadOffsetAndOpenMeshExit2NothingWritten) {
   const fs::path d = fresh_dir("crackbad");
-  auto r = run_rayaudit("crack-maps -o " + (d / "cm").string() + " --offsets 1,abc --mesh " RAYAUDIT_SOURCE_DIR
-                        "/scenes/meshes/cube.obj");
+  auto r = run_rayaudit("crack-maps -o " + (d / "cm").string() +
+                        " --offsets 1,abc --mesh " RAYAUDIT_SOURCE_DIR "/scenes/meshes/cube.obj");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "--offsets: 'abc' is not an offset between 0 and 1e30\n");
   r = run_rayaudit("crack-maps -o " + (d / "cm").string() + " --mesh " RAYAUDIT_SOURCE_DIR "/scenes/meshes/quad.obj");
@@ -261,7 +261,8 @@ TEST(ReportCli, ReportRefusesItsInputAsOutputAndBadStageTimes) {
                        "): it would be replaced; choose another output\n");
   EXPECT_EQ(slurp(audit), before);
   EXPECT_FALSE(fs::exists(d / "rep" / "index.html"));
-  for (const std::string& stage : {std::string("build\tnan\n"), std::string("build\t-5\n"), std::string("build\t1\0x\n", 10)}) {
+  for (const std::string& stage :
+       {std::string("build\tnan\n"), std::string("build\t-5\n"), std::string("build\t1\0x\n", 10)}) {
     std::ofstream(d / "st.tsv", std::ios::binary) << stage;
     r = run_rayaudit("report --audit " + audit.string() + " --stages " + (d / "st.tsv").string() + " -o " +
                      (d / "out").string());
@@ -310,7 +311,8 @@ TEST(ReportCli, ReportWithAnUnreadableCompareImageIsOneLine) {
   fs::create_directories(dir / "cmp");
   const fs::path audit = dir / "a.json";
   ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 20 --json " + audit.string()).code, 0);
-  std::ofstream(dir / "cmp" / "x.json") << R"({"width": 8, "height": 8, "differing": 0, "identical": true, "differences": []})";
+  std::ofstream(dir / "cmp" / "x.json")
+      << R"({"width": 8, "height": 8, "differing": 0, "identical": true, "differences": []})";
   std::ofstream(dir / "cmp" / "x-pov.png") << "not a png\n";
   const auto r = run_rayaudit("report --audit " + audit.string() + " --compare " + (dir / "cmp").string() + " -o " +
                               (dir / "rep").string());
@@ -343,8 +345,9 @@ TEST(CrackMapsCli, CrackMapsAbsurdWorkIsRefusedWithItsSize) {
   const auto r = run_rayaudit("crack-maps -o " + dir.string() + " --mesh " + kScenes +
                               "/meshes/tetrahedron.obj --size 1024 --offsets 1,10,100,1000,1e4");
   EXPECT_EQ(r.code, 2) << r.all;
-  EXPECT_EQ(r.err, "crack-maps: 90 maps of 1024x1024 pixels are 94371840 pixels (about 117 core-minutes); the "
-                   "limit is 16777216: fewer --offsets or --methods, or a smaller --size\n");
+  EXPECT_EQ(r.err,
+            "crack-maps: 90 maps of 1024x1024 pixels are 94371840 pixels (about 117 core-minutes); the "
+            "limit is 16777216: fewer --offsets or --methods, or a smaller --size\n");
   EXPECT_FALSE(fs::exists(dir));
 }
 
@@ -408,7 +411,7 @@ TEST(ReportCli, ReportNamesAnUnreadableOrHugeImageInOneLine) {
   // A PNG header declaring 16384 x 16384 (what compare --width 16384 writes):
   // refused from its size, not decoded (PIL's bomb error was 15 lines).
   std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x40\0\0\0\x40\0\x08\x02\0\0\0", 29);
-  png += "\x26\xaa\x87\xd3";  // the IHDR chunk's CRC (PIL checks it on opening)
+  png += "\x26\xaa\x87\xd3";                               // the IHDR chunk's CRC (PIL checks it on opening)
   png += std::string("\0\0\0\0IEND\xae\x42\x60\x82", 12);  // PIL reads the next chunk's header too
   std::ofstream(dir / "x-pov.png", std::ios::binary) << png;
   r = run_rayaudit("report --audit " + audit.string() + " --compare " + dir.string() + " -o " + out.string());

@@ -96,8 +96,10 @@ TEST(BenchSpread, EveryRowHasItsRepetitionsCalibrationAndSpread) {
 
 TEST(BenchSpread, RunsAreSeparateProcessesInOneJson) {
   const fs::path d = fresh_dir("runs");
-  const auto r = run_rayaudit("bench --quick --runs 2 --benchmark_repetitions=2 --benchmark_min_time=0.001 "
-                              "--filter '^kernel/moller/float/nocull/hit=50/back=0$' --json " + (d / "b.json").string());
+  const auto r = run_rayaudit(
+      "bench --quick --runs 2 --benchmark_repetitions=2 --benchmark_min_time=0.001 "
+      "--filter '^kernel/moller/float/nocull/hit=50/back=0$' --json " +
+      (d / "b.json").string());
   ASSERT_EQ(r.code, 0) << r.all;
   EXPECT_NE(r.out.find("run 2 of 2"), std::string::npos) << r.out;
   const json j = load(d / "b.json");
@@ -148,8 +150,9 @@ TEST(ReportPerf, CombinesRunsFlagsASlowedRowAndLeavesOutASlowRun) {
 
   // The slow run is named and left out: each row's figure is then from a
   // and b alone (the median of their two medians, computed here).
-  const json rs = report("--bench " + (d / "a.json").string() + " --bench " + (d / "b.json").string() +
-                             " --bench " + (d / "s.json").string(), "rs");
+  const json rs = report("--bench " + (d / "a.json").string() + " --bench " + (d / "b.json").string() + " --bench " +
+                             (d / "s.json").string(),
+                         "rs");
   const json& runs = rs.at("bench").at("runs");
   ASSERT_EQ(runs.size(), 3u);
   EXPECT_TRUE(runs[2].at("slow")) << runs.dump();
@@ -172,7 +175,8 @@ TEST(ReportPerf, CombinesRunsFlagsASlowedRowAndLeavesOutASlowRun) {
     if (ch.at("chart").get<std::string>().rfind("kernel_hit_rate/", 0) == 0) {
       kernel_chart = true;
       EXPECT_EQ(ch.at("ylim")[0].get<double>(), 0.0) << ch.dump();
-      for (const json& e : rs.at("bench").at("rows")) EXPECT_LE(e.at("max").get<double>(), ch.at("ylim")[1].get<double>());
+      for (const json& e : rs.at("bench").at("rows"))
+        EXPECT_LE(e.at("max").get<double>(), ch.at("ylim")[1].get<double>());
     }
   EXPECT_TRUE(kernel_chart);
   const std::string html = [&] {
@@ -195,24 +199,37 @@ TEST(ReportPerf, RatioChartsAreCentredOnOneXWithBarsFromIt) {
   json benchmarks = json::array();
   auto rep = [&](const std::string& name, const json& figures) {
     for (int i = 0; i < 3; ++i) {
-      json r = {{"name", name}, {"run_name", name}, {"run_type", "iteration"}, {"repetitions", 3},
-                {"repetition_index", i}, {"threads", 1}, {"iterations", 1}, {"real_time", 1.0}, {"cpu_time", 1.0},
-                {"time_unit", "ns"}, {"rayaudit_slow_phase", false}};
-      for (auto it = figures.begin(); it != figures.end(); ++it) r[it.key()] = it.value().get<double>() * (1 + 0.01 * (i - 1));
+      json r = {{"name", name},
+                {"run_name", name},
+                {"run_type", "iteration"},
+                {"repetitions", 3},
+                {"repetition_index", i},
+                {"threads", 1},
+                {"iterations", 1},
+                {"real_time", 1.0},
+                {"cpu_time", 1.0},
+                {"time_unit", "ns"},
+                {"rayaudit_slow_phase", false}};
+      for (auto it = figures.begin(); it != figures.end(); ++it)
+        r[it.key()] = it.value().get<double>() * (1 + 0.01 * (i - 1));
       benchmarks.push_back(r);
     }
   };
   for (const char* rays : {"primary", "shadow"})
     for (const std::string mesh : {"box", "bunny"}) {
       const double tris = mesh == "box" ? 12 : 69666, rays_n = 4096;
-      rep("scene/" + mesh + "/none/nocull/" + rays + "/threads=1", {{"Mrays_per_s", 1.0}, {"triangles", tris}, {"rays", rays_n}});
-      rep("scene/" + mesh + "/bvh/nocull/" + rays + "/threads=1", {{"Mrays_per_s", 850.0}, {"triangles", tris}, {"rays", rays_n}});
-      rep("scene/" + mesh + "/bvh/cull/" + rays + "/threads=1", {{"Mrays_per_s", 900.0}, {"triangles", tris}, {"rays", rays_n}});
+      rep("scene/" + mesh + "/none/nocull/" + rays + "/threads=1",
+          {{"Mrays_per_s", 1.0}, {"triangles", tris}, {"rays", rays_n}});
+      rep("scene/" + mesh + "/bvh/nocull/" + rays + "/threads=1",
+          {{"Mrays_per_s", 850.0}, {"triangles", tris}, {"rays", rays_n}});
+      rep("scene/" + mesh + "/bvh/cull/" + rays + "/threads=1",
+          {{"Mrays_per_s", 900.0}, {"triangles", tris}, {"rays", rays_n}});
     }
   rep("peer/embree/bunny/primary/default/threads=1", {{"ratio", 0.9}, {"rays", 4096.0}});
   rep("peer/cgal/bunny/primary/threads=1", {{"ratio", 1.006}, {"rays", 4096.0}});
   rep("peer/pov/bunny/threads=1", {{"ratio", 3.2}});
-  const json bench = {{"context", {{"num_cpus", 2}}}, {"benchmarks", benchmarks},
+  const json bench = {{"context", {{"num_cpus", 2}}},
+                      {"benchmarks", benchmarks},
                       {"rayaudit", {{"mode", "quick"}, {"rounds", 3}, {"runs", 1}}}};
   save(d / "b.json", bench);
   const auto r = run_rayaudit("report --bench " + (d / "b.json").string() + " -o " + (d / "rep").string());
@@ -233,7 +250,7 @@ TEST(ReportPerf, RatioChartsAreCentredOnOneXWithBarsFromIt) {
     EXPECT_EQ(ch.at(which + "lim"), ax.at("limits")) << id;
     EXPECT_EQ(ch.at("label_overlaps"), 0) << id;
     if (id == "peers") {
-      EXPECT_LT(lo, 0.9);   // the peer ahead shows left of 1x
+      EXPECT_LT(lo, 0.9);         // the peer ahead shows left of 1x
       EXPECT_GT(hi, 3.2 * 1.01);  // the largest ratio and its spread
     } else if (id.find("culling") != std::string::npos) {
       EXPECT_GT(hi, 900.0 / 850.0 * 1.01) << id;  // culling's 1.06x and its spread

@@ -27,10 +27,13 @@ fs::path tmp(const std::string& name) {
 TEST(ReportUsers, GradedSubjectIsLabelledOnTheSpeedChartBesideOurs) {
   const fs::path main = tmp("main.json"), cases = tmp("cases.csv"), answers = tmp("mine.csv"), graded = tmp("g.json"),
                  bench = tmp("bench.json"), timings = tmp("timings.csv"), out = tmp("rep");
-  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge,grazing --rays 1000 --seed 4 --json " + main.string())
-                .code, 0);
+  ASSERT_EQ(
+      run_rayaudit("audit --methods moller --families edge,grazing --rays 1000 --seed 4 --json " + main.string()).code,
+      0);
   ASSERT_EQ(run_rayaudit("audit --export-cases " + cases.string() +
-                         " --families edge,grazing --rays 1000 --seed 4 --precision float").code, 0);
+                         " --families edge,grazing --rays 1000 --seed 4 --precision float")
+                .code,
+            0);
   // The user's answers: every case a miss (wrong, but graded all the same).
   {
     std::ifstream in(cases);
@@ -40,8 +43,10 @@ TEST(ReportUsers, GradedSubjectIsLabelledOnTheSpeedChartBesideOurs) {
     a << "id,hit,t\n";
     while (std::getline(in, line)) a << line.substr(0, line.find(',')) << ",false,\n";
   }
-  ASSERT_EQ(run_rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " +
-                         graded.string()).code, 0);
+  ASSERT_EQ(
+      run_rayaudit("audit --grade " + answers.string() + " --cases " + cases.string() + " --json " + graded.string())
+          .code,
+      0);
   // Our kernel rows as `rayaudit bench` writes them, and the user's timing
   // (validation/baseline/timing.h writes this CSV; other languages too).
   std::ofstream(bench) << R"({"context": {"host_name": "h"}, "benchmarks": [
@@ -75,7 +80,8 @@ TEST(ReportUsers, GradedSubjectIsLabelledOnTheSpeedChartBesideOurs) {
 
   // Audits of other seeds are refused in one line.
   const fs::path other = tmp("other.json");
-  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 1000 --seed 5 --json " + other.string()).code, 0);
+  ASSERT_EQ(run_rayaudit("audit --methods moller --families edge --rays 1000 --seed 5 --json " + other.string()).code,
+            0);
   r = run_rayaudit("report --audit " + main.string() + " --audit " + other.string() + " -o " + tmp("x").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(one_line(r.err)) << r.err;

@@ -25,7 +25,8 @@ struct CliResult {
 // `env` is prefixed to the command line (e.g. "RAYAUDIT_CACHE=/x").
 inline CliResult run_rayaudit(const std::string& args, const std::string& env = "") {
   static int counter = 0;
-  const std::filesystem::path err_file = std::filesystem::temp_directory_path() /
+  const std::filesystem::path err_file =
+      std::filesystem::temp_directory_path() /
       ("rayaudit-test-stderr-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
   const std::string cmd = env + " " + std::string(RAYAUDIT_EXE) + " " + args + " 2>" + err_file.string();
   FILE* p = popen(cmd.c_str(), "r");
@@ -71,7 +72,8 @@ inline bool one_line(const std::string& s) { return !s.empty() && s.back() == '\
 inline ::testing::AssertionResult refused(const CliResult& r, const std::string& start) {
   if (r.code != 2) return ::testing::AssertionFailure() << "exit " << r.code << ", not 2: " << r.all;
   if (!one_line(r.err)) return ::testing::AssertionFailure() << "not one line: " << r.err;
-  if (r.err.rfind(start, 0) != 0) return ::testing::AssertionFailure() << "does not start with " << start << ": " << r.err;
+  if (r.err.rfind(start, 0) != 0)
+    return ::testing::AssertionFailure() << "does not start with " << start << ": " << r.err;
   return ::testing::AssertionSuccess();
 }
 
@@ -86,8 +88,8 @@ inline std::filesystem::path scratch(const std::string& name) {
 
 // A copy of `text` in the scratch file NAME with its first `from` replaced
 // by `to` (a failed expectation, and the text unchanged, if there is none).
-inline std::filesystem::path scratch_variant(const std::string& text, const std::string& name,
-                                             const std::string& from, const std::string& to) {
+inline std::filesystem::path scratch_variant(const std::string& text, const std::string& name, const std::string& from,
+                                             const std::string& to) {
   std::string t = text;
   const auto at = t.find(from);
   EXPECT_NE(at, std::string::npos) << from;

@@ -23,8 +23,8 @@ const std::string kSource = RAYAUDIT_SOURCE_DIR;
 bool loads_oiio(const std::string& loader_log) { return loader_log.find("file=libOpenImageIO") != std::string::npos; }
 
 TEST(Startup, CommandsWithoutImagesDoNotLoadOpenImageIO) {
-  for (const std::string& args : std::vector<std::string>{"--version", "methods", "info " + kSource + "/scenes/meshes/quad.obj",
-                                 "audit --rays 200 --families edge"}) {
+  for (const std::string& args : std::vector<std::string>{
+           "--version", "methods", "info " + kSource + "/scenes/meshes/quad.obj", "audit --rays 200 --families edge"}) {
     const auto r = run_rayaudit(args, "LD_DEBUG=files");
     EXPECT_EQ(r.code, 0) << args << "\n" << r.all.substr(0, 2000);
     EXPECT_NE(r.err.find("file="), std::string::npos) << "no loader log for " << args;
@@ -35,8 +35,8 @@ TEST(Startup, CommandsWithoutImagesDoNotLoadOpenImageIO) {
 // The control: a textured render does load it, and writes its image.
 TEST(Startup, ATexturedRenderLoadsTheImageModule) {
   const fs::path out = scratch("textured.png");
-  const auto r = run_rayaudit("render " + kSource + "/scenes/teapot-textured.json --width 32 --height 24 -o " +
-                                  out.string(), "LD_DEBUG=files");
+  const auto r = run_rayaudit(
+      "render " + kSource + "/scenes/teapot-textured.json --width 32 --height 24 -o " + out.string(), "LD_DEBUG=files");
   EXPECT_EQ(r.code, 0) << r.all.substr(r.all.size() > 2000 ? r.all.size() - 2000 : 0);
   EXPECT_TRUE(loads_oiio(r.err));
   EXPECT_GT(fs::file_size(out), 100u);

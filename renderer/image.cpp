@@ -40,8 +40,10 @@ std::vector<unsigned char> encode_png(const Image& img, const ImageWriteOptions&
   std::vector<std::uint16_t> px16(eight ? 0 : n);
   for (std::size_t i = 0; i < n; ++i) {
     const unsigned q = quantize(opt.srgb ? srgb_encode(img.rgb[i]) : img.rgb[i], max);
-    if (eight) px8[i] = std::uint8_t(q);
-    else px16[i] = std::uint16_t(q);
+    if (eight)
+      px8[i] = std::uint8_t(q);
+    else
+      px16[i] = std::uint16_t(q);
   }
   std::vector<unsigned char> bytes;
   std::string err;
@@ -103,7 +105,6 @@ class QuietStderr {
   int saved_ = -1;
 };
 
-
 }  // namespace
 
 namespace {
@@ -115,11 +116,13 @@ void check_declared_size(const std::string& name, const char* what, std::uint64_
                          std::uint64_t bytes) {
   const std::string dims = std::to_string(w) + "x" + std::to_string(h);
   if (w > kMaxImageSide || h > kMaxImageSide)
-    throw InputError(located(name, 0, what + std::string(" is ") + dims + ", more than the limit of " +
-                                          std::to_string(kMaxImageSide) + " pixels a side"));
+    throw InputError(located(name, 0,
+                             what + std::string(" is ") + dims + ", more than the limit of " +
+                                 std::to_string(kMaxImageSide) + " pixels a side"));
   if (bytes && w * h > bytes * kMaxPixelsPerByte)
-    throw InputError(located(name, 0, what + std::string(" header declares ") + dims + " pixels, more than its " +
-                                          std::to_string(bytes) + " bytes can hold (the file is truncated or corrupt)"));
+    throw InputError(located(name, 0,
+                             what + std::string(" header declares ") + dims + " pixels, more than its " +
+                                 std::to_string(bytes) + " bytes can hold (the file is truncated or corrupt)"));
 }
 
 // An image opened by the module, its header checked against the limits.
@@ -135,7 +138,8 @@ OpenedImage open_checked(const std::filesystem::path& path, const char* what) {
   // What OIIO's readers accept silently (a PNG without IEND, a PNM maxval
   // of 0), or an empty file, said before OIIO is asked.
   const ImageProblem why = image_container_problem(path);
-  if (!why.what.empty()) throw InputError(located(name, why.line, std::string("cannot read ") + what + ": " + why.what));
+  if (!why.what.empty())
+    throw InputError(located(name, why.line, std::string("cannot read ") + what + ": " + why.what));
   std::error_code ec;
   const std::uint64_t bytes = std::filesystem::file_size(path, ec);
   if (why.width || why.height) check_declared_size(name, what, why.width, why.height, ec ? 0 : bytes);
@@ -144,13 +148,15 @@ OpenedImage open_checked(const std::filesystem::path& path, const char* what) {
   o.name = name;
   std::string err;
   o.in = std::unique_ptr<void, void (*)(void*)>(oiio.open(name.c_str(), &o.spec, &err), oiio.close);
-  if (!o.in) throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + image_open_problem(path, err)));
+  if (!o.in)
+    throw InputError(located(name, 0, std::string("cannot read ") + what + ": " + image_open_problem(path, err)));
   const image_module::Header& spec = o.spec;
   const std::uint64_t w = std::uint64_t(std::max(spec.width, 0)), h = std::uint64_t(std::max(spec.height, 0));
   o.dims = std::to_string(w) + "x" + std::to_string(h);
   if (w == 0 || h == 0 || spec.channels < 1 || spec.channels > 64)
-    throw InputError(located(name, 0, what + std::string(" header declares ") + o.dims + " with " +
-                                          std::to_string(spec.channels) + " channels"));
+    throw InputError(located(
+        name, 0,
+        what + std::string(" header declares ") + o.dims + " with " + std::to_string(spec.channels) + " channels"));
   check_declared_size(name, what, w, h, ec ? 0 : bytes);
   return o;
 }
@@ -160,10 +166,11 @@ template <class T>
 void allocate(std::vector<T>& v, std::uint64_t n, const OpenedImage& o, const char* what) {
   const std::uint64_t need = n * sizeof(T), avail = available_memory();
   auto fail = [&] {
-    throw InputError(located(o.name, 0, what + std::string(" of ") + o.dims + " needs " +
-                                            std::to_string((need + (1 << 20) - 1) >> 20) + " MB to read, but only " +
-                                            std::to_string(avail >> 20) +
-                                            " MB are available (free memory, or `ulimit -v`): not enough memory"));
+    throw InputError(located(o.name, 0,
+                             what + std::string(" of ") + o.dims + " needs " +
+                                 std::to_string((need + (1 << 20) - 1) >> 20) + " MB to read, but only " +
+                                 std::to_string(avail >> 20) +
+                                 " MB are available (free memory, or `ulimit -v`): not enough memory"));
   };
   if (need > avail) fail();
   try {
@@ -219,9 +226,10 @@ StoredPixels read_stored_pixels(const std::filesystem::path& path, const char* w
       for (std::size_t i = 0; i < p.f.size(); ++i)
         if (!std::isfinite(p.f[i])) {
           const std::size_t px = i / std::size_t(p.channels);
-          throw InputError(located(o.name, 0, std::string(what) + " texel (" + std::to_string(px % std::size_t(p.width)) +
-                                                  ", " + std::to_string(px / std::size_t(p.width)) + ") is " +
-                                                  (std::isnan(p.f[i]) ? "NaN" : "infinite") + ", not a colour"));
+          throw InputError(located(o.name, 0,
+                                   std::string(what) + " texel (" + std::to_string(px % std::size_t(p.width)) + ", " +
+                                       std::to_string(px / std::size_t(p.width)) + ") is " +
+                                       (std::isnan(p.f[i]) ? "NaN" : "infinite") + ", not a colour"));
         }
   }
   return p;

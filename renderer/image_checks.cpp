@@ -30,7 +30,8 @@ std::string png_problem(std::ifstream& in, std::uint64_t size) {
     if (at + 8 > size || !in.read(reinterpret_cast<char*>(h), 8))
       return "byte " + std::to_string(at) + ": the PNG ends before its IEND chunk (the file is truncated)";
     const std::uint64_t len = be32(h);
-    if (len > 0x7FFFFFFFu) return "byte " + std::to_string(at) + ": PNG chunk length " + std::to_string(len) + " out of range";
+    if (len > 0x7FFFFFFFu)
+      return "byte " + std::to_string(at) + ": PNG chunk length " + std::to_string(len) + " out of range";
     if (std::string(reinterpret_cast<char*>(h + 4), 4) == "IEND") return "";
     at += 12 + len;  // length, type, data, CRC
   }
@@ -41,7 +42,11 @@ std::string png_problem(std::ifstream& in, std::uint64_t size) {
 // or -5, were read as given).
 ImageProblem pnm_problem(std::ifstream& in, std::uint64_t size) {
   in.seekg(0);
-  const char kind = [&] { char k[2] = {}; in.read(k, 2); return k[1]; }();
+  const char kind = [&] {
+    char k[2] = {};
+    in.read(k, 2);
+    return k[1];
+  }();
   const bool ascii = kind >= '1' && kind <= '3';
   in.seekg(0);
   std::string head(ascii ? std::size_t(size) : 512, '\0');
@@ -72,7 +77,8 @@ ImageProblem pnm_problem(std::ifstream& in, std::uint64_t size) {
     skip();
     std::uint64_t v = 0;
     const std::size_t b = i;
-    while (i < head.size() && std::isdigit(static_cast<unsigned char>(head[i])) && i - b < 12) v = v * 10 + std::uint64_t(head[i++] - '0');
+    while (i < head.size() && std::isdigit(static_cast<unsigned char>(head[i])) && i - b < 12)
+      v = v * 10 + std::uint64_t(head[i++] - '0');
     if (i == b || (i < head.size() && !std::isspace(static_cast<unsigned char>(head[i])))) {
       i = b;
       return {line, std::string("PNM header: expected the ") + names[f] + ", found '" + token() + "'"};
@@ -112,7 +118,8 @@ ImageProblem pnm_problem(std::ifstream& in, std::uint64_t size) {
     }
     const std::size_t b = i;
     std::uint64_t v = 0;
-    while (i < head.size() && std::isdigit(static_cast<unsigned char>(head[i])) && i - b < 12) v = v * 10 + std::uint64_t(head[i++] - '0');
+    while (i < head.size() && std::isdigit(static_cast<unsigned char>(head[i])) && i - b < 12)
+      v = v * 10 + std::uint64_t(head[i++] - '0');
     if (i == b || (i < head.size() && !std::isspace(static_cast<unsigned char>(head[i])) && head[i] != '#')) {
       i = b;
       return {line, "PNM sample '" + token() + "' is not a number from 0 to the maxval " + std::to_string(maxval)};
@@ -201,7 +208,8 @@ ImageProblem image_container_problem(const std::filesystem::path& path) {
   if (got == 8 && std::equal(sig, sig + 8, kPngSignature)) return {0, png_problem(in, size)};
   if (got >= 3 && sig[0] == 'P' && sig[1] >= '1' && sig[1] <= '6' && std::isspace(sig[2])) return pnm_problem(in, size);
   if (got >= 3 && sig[0] == 'P' && (sig[1] == 'F' || sig[1] == 'f') && std::isspace(sig[2])) return pfm_problem(in);
-  if (got >= 6 && (std::string(reinterpret_cast<char*>(sig), 6) == "GIF87a" || std::string(reinterpret_cast<char*>(sig), 6) == "GIF89a"))
+  if (got >= 6 && (std::string(reinterpret_cast<char*>(sig), 6) == "GIF87a" ||
+                   std::string(reinterpret_cast<char*>(sig), 6) == "GIF89a"))
     return gif_size(in, size);
   return {};
 }

@@ -73,9 +73,10 @@ const Api* load() {
       // OpenImageIO's dependencies start threads in their initialisers: under
       // a low `ulimit -v` that throws out of dlopen ("rayaudit: error:
       // Resource temporarily unavailable", naming nothing).
-      throw InputError(located(by_name ? std::string(kFileName) : path, 0,
-                               std::string("cannot load the image module: ") + e.what() +
-                                   " (a library's thread could not start: is the address-space limit `ulimit -v` too low?)"));
+      throw InputError(
+          located(by_name ? std::string(kFileName) : path, 0,
+                  std::string("cannot load the image module: ") + e.what() +
+                      " (a library's thread could not start: is the address-space limit `ulimit -v` too low?)"));
     }
     if (!handle) {
       // A file that is there but does not load (a missing OpenImageIO
@@ -88,13 +89,13 @@ const Api* load() {
     auto entry = reinterpret_cast<Entry>(::dlsym(handle, "rayaudit_image_module_api"));
     const Api* api = entry ? entry() : nullptr;
     if (!api || api->version != kVersion || api->size != sizeof(Api))
-      throw InputError(located(path, 0, "not the image module of this rayaudit (version " RAYAUDIT_VERSION
-                                        "): rebuild or reinstall it"));
+      throw InputError(located(
+          path, 0, "not the image module of this rayaudit (version " RAYAUDIT_VERSION "): rebuild or reinstall it"));
     return api;
   }
   throw InputError(located(kFileName, 0,
-                           "the image module (OpenImageIO reading and writing) is not installed: looked for " +
-                               tried + "; set RAYAUDIT_IMAGE_MODULE to its path"));
+                           "the image module (OpenImageIO reading and writing) is not installed: looked for " + tried +
+                               "; set RAYAUDIT_IMAGE_MODULE to its path"));
 }
 
 }  // namespace

@@ -34,8 +34,10 @@ std::uint64_t system_available() {
     std::string key;
     std::uint64_t kb = 0;
     ls >> key >> kb;
-    if (key == "MemAvailable:") avail = kb * 1024, found = true;
-    else if (key == "SwapFree:") swap = kb * 1024;
+    if (key == "MemAvailable:")
+      avail = kb * 1024, found = true;
+    else if (key == "SwapFree:")
+      swap = kb * 1024;
   }
   return found ? avail + swap : std::numeric_limits<std::uint64_t>::max();
 }
@@ -46,7 +48,8 @@ std::string megabytes(std::uint64_t bytes) { return std::to_string((bytes + (1 <
 
 std::uint64_t address_space_left() {
   rlimit as{};
-  if (::getrlimit(RLIMIT_AS, &as) != 0 || as.rlim_cur == RLIM_INFINITY) return std::numeric_limits<std::uint64_t>::max();
+  if (::getrlimit(RLIMIT_AS, &as) != 0 || as.rlim_cur == RLIM_INFINITY)
+    return std::numeric_limits<std::uint64_t>::max();
   const std::uint64_t used = mapped_now();
   return as.rlim_cur > used ? as.rlim_cur - used : 0;
 }
@@ -57,9 +60,10 @@ void check_image_memory(const std::string& what, int width, int height, int byte
   const std::uint64_t need = std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(bytes_per_pixel);
   const std::uint64_t avail = available_memory();
   if (need > avail)
-    throw InputError(what + ": " + std::to_string(width) + "x" + std::to_string(height) + " needs about " +
-                     megabytes(need) + " for its image buffers, but only " + megabytes(avail) +
-                     " are available (free memory, or the address-space limit `ulimit -v`): lower the width and height");
+    throw InputError(
+        what + ": " + std::to_string(width) + "x" + std::to_string(height) + " needs about " + megabytes(need) +
+        " for its image buffers, but only " + megabytes(avail) +
+        " are available (free memory, or the address-space limit `ulimit -v`): lower the width and height");
 }
 
 }  // namespace ra

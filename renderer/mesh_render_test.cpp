@@ -31,9 +31,7 @@ std::filesystem::path temp_dir() {
   return d;
 }
 
-void write_text(const std::filesystem::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-}
+void write_text(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
 
 // A UV sphere of radius 1 at the origin: `rings` x `segments`, triangles
 // wound outward, optionally with exact vn (= the vertex position).
@@ -59,8 +57,10 @@ std::string uv_sphere_obj(int rings, int segments, bool with_vn) {
       index[r * segments + k] = ++n;
     }
   auto face = [&](int a, int b, int c) {
-    if (with_vn) std::snprintf(buf, sizeof buf, "f %d//%d %d//%d %d//%d\n", a, a, b, b, c, c);
-    else std::snprintf(buf, sizeof buf, "f %d %d %d\n", a, b, c);
+    if (with_vn)
+      std::snprintf(buf, sizeof buf, "f %d//%d %d//%d %d//%d\n", a, a, b, b, c, c);
+    else
+      std::snprintf(buf, sizeof buf, "f %d %d %d\n", a, b, c);
     s += buf;
   };
   for (int r = 0; r < rings; ++r)
@@ -85,9 +85,7 @@ Vec3d random_unit(std::mt19937_64& rng) {
   return normalize(Vec3d{g(rng), g(rng), g(rng)});
 }
 
-double angle(const Vec3d& a, const Vec3d& b) {
-  return std::atan2(length(cross(a, b)), dot(a, b));
-}
+double angle(const Vec3d& a, const Vec3d& b) { return std::atan2(length(cross(a, b)), dot(a, b)); }
 
 // ---------------------------------------------------------------- smooth
 
@@ -353,7 +351,8 @@ TEST(Texture, EightAndSixteenBitTexelsAreOiiosFloatsBitForBit) {
 // lines, and a PFM's negative (little-endian) scale.
 TEST(Texture, ValidPnmAndPfmTexturesStillLoad) {
   const auto dir = temp_dir();
-  std::ofstream(dir / "a.ppm") << "P3\n# made by hand\n2 1 # size\n15\n15 0 7\n# a comment between samples\n0 15 15 # end\n";
+  std::ofstream(dir / "a.ppm")
+      << "P3\n# made by hand\n2 1 # size\n15\n15 0 7\n# a comment between samples\n0 15 15 # end\n";
   const Texture a = load_texture(dir / "a.ppm");
   EXPECT_EQ(a.texel(0, 0).x, 1.0);
   EXPECT_EQ(a.texel(1, 0).y, 1.0);
@@ -372,10 +371,10 @@ TEST(Texture, ValidPnmAndPfmTexturesStillLoad) {
 TEST(Texture, BottomUpTgaIsReadUpright) {
   const auto file = temp_dir() / "bottom-up.tga";
   std::string bytes(18, '\0');
-  bytes[2] = 2;   // uncompressed true-colour
-  bytes[12] = 4;  // width, little-endian
-  bytes[14] = 2;  // height
-  bytes[16] = 24; // bits per pixel; bytes[17] = 0: bottom-left origin
+  bytes[2] = 2;    // uncompressed true-colour
+  bytes[12] = 4;   // width, little-endian
+  bytes[14] = 2;   // height
+  bytes[16] = 24;  // bits per pixel; bytes[17] = 0: bottom-left origin
   for (int y = 1; y >= 0; --y)
     for (int x = 0; x < 4; ++x)
       for (int c : {2, 1, 0}) bytes += char(tga_level(x, y, c));
@@ -404,7 +403,7 @@ TEST(Texture, PigmentOfATexturedMeshIsTheTexelAtItsUv) {
   Scene scene = load_scene(dir / "quad.json");
   Tracer tr(scene, opts());
   auto at = [&](double x, double y) { return tr.trace({{x, y, 5}, {0, 0, -1}}); };
-  EXPECT_EQ(at(-0.5, 0.5), (Color{1, 0, 0}));   // top-left of the quad = top-left texel
+  EXPECT_EQ(at(-0.5, 0.5), (Color{1, 0, 0}));  // top-left of the quad = top-left texel
   EXPECT_EQ(at(0.5, 0.5), (Color{0, 1, 0}));
   EXPECT_EQ(at(-0.5, -0.5), (Color{0, 0, 1}));  // v = 0 at the bottom
   EXPECT_EQ(at(0.5, -0.5), (Color{1, 1, 1}));
@@ -661,8 +660,10 @@ TEST(Accel, CullingChangesNothingOnClosedMeshesSeenFromOutside) {
   write_text(dir / "ball.obj", uv_sphere_obj(16, 32, false));
   for (const char* shading : {"flat", "smooth"}) {
     write_text(dir / "closed.json", std::string(R"({"width": 48, "height": 36, "lights": [{"position": [3, 5, 4]}],
-        "objects": [{"mesh": "ball.obj", "shading": ")") + shading + R"("},
-                    {"mesh": "ball.obj", "translate": [1.8, 0.5, -1], "shading": ")" + shading + R"("}]})");
+        "objects": [{"mesh": "ball.obj", "shading": ")") +
+                                        shading + R"("},
+                    {"mesh": "ball.obj", "translate": [1.8, 0.5, -1], "shading": ")" +
+                                        shading + R"("}]})");
     const Scene scene = load_scene(dir / "closed.json");
     for (Accel a : {Accel::none, Accel::sphere, Accel::bvh}) {
       RenderOptions o = opts();
@@ -868,8 +869,9 @@ TEST(MtlMapping, AmbientWithoutDiffuseIsDroppedWithAWarning) {
 // triangles, so they agree); the other face keeps its own.
 TEST(MeshNormals, ZeroLengthVnFallsBackToComputedNormals) {
   const auto dir = temp_dir();
-  write_text(dir / "z.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvn 0 0 0\n"
-                            "f 1//1 2//1 3//2\nf 2//1 4//1 3//1\n");
+  write_text(dir / "z.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvn 0 0 0\n"
+             "f 1//1 2//1 3//2\nf 2//1 4//1 3//1\n");
   MeshPlacement place;
   place.file = dir / "z.obj";
   place.shading = Shading::smooth;

@@ -30,9 +30,9 @@
 namespace ra {
 
 struct PovMeshHit {
-  Vec3d p;            // O + t Dir, t from POV's float32 plane
+  Vec3d p;                // O + t Dir, t from POV's float32 plane
   double b1 = 0, b2 = 0;  // POV's weights of b and c at p (a has 1 - b1 - b2)
-  bool ok = false;    // false: the ray is parallel to the plane (|S.Dir| < 1e-10)
+  bool ok = false;        // false: the ray is parallel to the plane (|S.Dir| < 1e-10)
 };
 
 // The hit of ray r on triangle (a, b, c), listed in that order in the mesh2's

@@ -25,10 +25,9 @@ std::string_view kind_name(Kind k);
 // side that the normal (B - A) x (C - A) points to.
 template <class T>
 struct TriangleKernels {
-  std::optional<TriangleHit<T>> (*hit)(const Ray<T>&, const Vec3<T>&, const Vec3<T>&,
-                                       const Vec3<T>&, bool cull) = nullptr;
-  bool (*any)(const Ray<T>&, const Vec3<T>&, const Vec3<T>&, const Vec3<T>&,
-              bool cull) = nullptr;
+  std::optional<TriangleHit<T>> (*hit)(const Ray<T>&, const Vec3<T>&, const Vec3<T>&, const Vec3<T>&,
+                                       bool cull) = nullptr;
+  bool (*any)(const Ray<T>&, const Vec3<T>&, const Vec3<T>&, const Vec3<T>&, bool cull) = nullptr;
   void (*prepare)(const Vec3<T>&, const Vec3<T>&, const Vec3<T>&, void* out) = nullptr;
   std::optional<TriangleHit<T>> (*hit_pre)(const Ray<T>&, const void* pre, bool cull) = nullptr;
   bool (*any_pre)(const Ray<T>&, const void* pre, bool cull) = nullptr;
@@ -50,7 +49,7 @@ struct PlaneKernels {
 };
 
 struct Method {
-  std::string name;         // the CLI's name, e.g. "watertight"
+  std::string name;  // the CLI's name, e.g. "watertight"
   Kind kind;
   std::string source;       // seed file and section, or paper
   std::string description;  // one line
@@ -68,14 +67,26 @@ struct Method {
   PlaneKernels<float> pln_f;
   PlaneKernels<double> pln_d;
 
-  template <class T> const TriangleKernels<T>& triangle() const {
-    if constexpr (sizeof(T) == sizeof(float)) return tri_f; else return tri_d;
+  template <class T>
+  const TriangleKernels<T>& triangle() const {
+    if constexpr (sizeof(T) == sizeof(float))
+      return tri_f;
+    else
+      return tri_d;
   }
-  template <class T> const SphereKernels<T>& sphere() const {
-    if constexpr (sizeof(T) == sizeof(float)) return sph_f; else return sph_d;
+  template <class T>
+  const SphereKernels<T>& sphere() const {
+    if constexpr (sizeof(T) == sizeof(float))
+      return sph_f;
+    else
+      return sph_d;
   }
-  template <class T> const PlaneKernels<T>& plane() const {
-    if constexpr (sizeof(T) == sizeof(float)) return pln_f; else return pln_d;
+  template <class T>
+  const PlaneKernels<T>& plane() const {
+    if constexpr (sizeof(T) == sizeof(float))
+      return pln_f;
+    else
+      return pln_d;
   }
 };
 

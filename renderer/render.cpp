@@ -38,9 +38,12 @@ std::optional<Accel> parse_accel(std::string_view s) {
 }
 const char* accel_name(Accel a) {
   switch (a) {
-    case Accel::none: return "none";
-    case Accel::sphere: return "sphere";
-    case Accel::bvh: return "bvh";
+    case Accel::none:
+      return "none";
+    case Accel::sphere:
+      return "sphere";
+    case Accel::bvh:
+      return "bvh";
   }
   return "?";
 }
@@ -82,17 +85,17 @@ template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
   std::size_t stride = 0;
-  std::vector<unsigned char> pre;  // per triangle, or per BVH slot
-  Bvh bvh;                         // --accel bvh only
+  std::vector<unsigned char> pre;                                             // per triangle, or per BVH slot
+  Bvh bvh;                                                                    // --accel bvh only
   std::vector<moller_simd::Tri4<T>, DefaultInit<moller_simd::Tri4<T>>> tri4;  // per BVH leaf, moller only
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
   double bs_radius = 0;
-  Vec3d lo, hi;      // the box of its vertices, padded by `pad` (the BVH's padding)
+  Vec3d lo, hi;  // the box of its vertices, padded by `pad` (the BVH's padding)
   double pad = 0;
-  double scale = 0;  // max(its size, its farthest coordinate): pad = 1e-5 scale
+  double scale = 0;                      // max(its size, its farthest coordinate): pad = 1e-5 scale
   std::uint32_t one_leaf = Bvh::kEmpty;  // the BVH's only leaf, when it has one (at most 4 triangles)
-  bool cull = false;  // --cull, and the mesh is closed (cull_unsafe_reason)
+  bool cull = false;                     // --cull, and the mesh is closed (cull_unsafe_reason)
 };
 
 // Asks for a leaf block's cache lines ahead of its test.
@@ -132,8 +135,10 @@ constexpr double unit_roundoff() {
 // The least T at or above x (the window's tmax for a t that T may not hold).
 template <class T>
 [[gnu::always_inline]] inline T t_above(double x) {
-  if constexpr (sizeof(T) == 4) return bvh_detail::round_up(x);
-  else return x;
+  if constexpr (sizeof(T) == 4)
+    return bvh_detail::round_up(x);
+  else
+    return x;
 }
 
 // Is (t, object, prim) nearer than the best so far? Ties on t go to the lower
@@ -157,20 +162,17 @@ struct Tracer::Impl {
 
   std::vector<PreparedMesh<float>> meshes_f;
   std::vector<PreparedMesh<double>> meshes_d;
-  std::vector<int> mesh_index;  // object -> index into meshes_*, or -1
-  TextureCache textures;        // every texture and bump image, loaded here
+  std::vector<int> mesh_index;                 // object -> index into meshes_*, or -1
+  TextureCache textures;                       // every texture and bump image, loaded here
   std::map<std::string, Texture> derivatives;  // height bumps: file -> (dx, dy)
 
-  Impl(const Scene& s, const RenderOptions& o)
-      : scene(s), opt(o), camera(s.camera, s.width, s.height) {
+  Impl(const Scene& s, const RenderOptions& o) : scene(s), opt(o), camera(s.camera, s.width, s.height) {
     tri_method = find_method(o.triangle_method);
     if (!tri_method || tri_method->kind != Kind::triangle)
-      throw InputError("unknown triangle method \"" + o.triangle_method +
-                       "\"; valid: " + method_names(Kind::triangle));
+      throw InputError("unknown triangle method \"" + o.triangle_method + "\"; valid: " + method_names(Kind::triangle));
     sph_method = find_method(o.sphere_method);
     if (!sph_method || sph_method->kind != Kind::sphere)
-      throw InputError("unknown sphere method \"" + o.sphere_method +
-                       "\"; valid: " + method_names(Kind::sphere));
+      throw InputError("unknown sphere method \"" + o.sphere_method + "\"; valid: " + method_names(Kind::sphere));
     pln_method = &default_method(Kind::plane);
     avx2 = o.simd && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
     avx512 = avx2 && o.avx512 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
@@ -189,8 +191,10 @@ struct Tracer::Impl {
           prepared.emplace(s.objects[i].mesh.get(), int(opt.use_double ? meshes_d.size() : meshes_f.size()));
       mesh_index[i] = it->second;
       if (!fresh) continue;
-      if (opt.use_double) meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
-      else meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
+      if (opt.use_double)
+        meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
+      else
+        meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
     }
     // The sphere far rays are moved to (shift): around every mesh, with the
     // least padding and the largest scale among them.
@@ -204,8 +208,10 @@ struct Tracer::Impl {
           meshes_scale = std::max(meshes_scale, m.scale);
         }
       };
-      if (opt.use_double) each(meshes_d);
-      else each(meshes_f);
+      if (opt.use_double)
+        each(meshes_d);
+      else
+        each(meshes_f);
       if (meshes_scale > 0) {
         meshes_center = (lo + hi) * 0.5;
         meshes_radius = length(hi - lo) * 0.5;
@@ -213,8 +219,8 @@ struct Tracer::Impl {
     }
     build_object_bvh();
     init_glass();
-    one_mesh_tri4 = avx2 && s.objects.size() == 1 && s.objects[0].kind == Object::Kind::mesh && !opt.pov_mesh_intersect &&
-                    (opt.use_double ? !meshes_d[0].tri4.empty() : !meshes_f[0].tri4.empty());
+    one_mesh_tri4 = avx2 && s.objects.size() == 1 && s.objects[0].kind == Object::Kind::mesh &&
+                    !opt.pov_mesh_intersect && (opt.use_double ? !meshes_d[0].tri4.empty() : !meshes_f[0].tri4.empty());
     for (const Object& obj : s.objects) {
       if (obj.kind == Object::Kind::mesh)
         for (const Material& m : obj.mesh->materials) load_textures(m);
@@ -234,10 +240,10 @@ struct Tracer::Impl {
           // 3 floats a texel, whatever the image's own size a texel.
           const std::uint64_t need = std::uint64_t(img.width) * std::uint64_t(img.height) * 3 * sizeof(float);
           if (need > available_memory())
-            throw InputError(located(m.bump->file.string(), 0, "height bump map of " + std::to_string(img.width) + "x" +
-                                                                   std::to_string(img.height) + " needs " +
-                                                                   std::to_string(need >> 20) +
-                                                                   " MB for its derivatives: not enough memory"));
+            throw InputError(located(m.bump->file.string(), 0,
+                                     "height bump map of " + std::to_string(img.width) + "x" +
+                                         std::to_string(img.height) + " needs " + std::to_string(need >> 20) +
+                                         " MB for its derivatives: not enough memory"));
           derivatives.emplace(key, height_derivatives(img));
         }
       }
@@ -278,7 +284,10 @@ struct Tracer::Impl {
 
   template <class T>
   const PreparedMesh<T>& soup() const {
-    if constexpr (sizeof(T) == 4) return soup_f; else return soup_d;
+    if constexpr (sizeof(T) == 4)
+      return soup_f;
+    else
+      return soup_d;
   }
 
   bool object_bvh_for(const Vec3d& o) const { return objects_bounded && max_component(abs(o)) <= reach; }
@@ -313,8 +322,10 @@ struct Tracer::Impl {
     soup_set.name = "lone triangles";
     soup_set.materials = {Material{}};
     if (!lone.empty()) {
-      if (opt.use_double) soup_d = prepare<double>(soup_set, false);
-      else soup_f = prepare<float>(soup_set, false);
+      if (opt.use_double)
+        soup_d = prepare<double>(soup_set, false);
+      else
+        soup_f = prepare<float>(soup_set, false);
     }
     std::vector<Vec3d> lo(objs.size()), hi(objs.size());
     for (std::size_t k = 0; k < objs.size(); ++k) {
@@ -421,7 +432,8 @@ struct Tracer::Impl {
     if (opt.cull && cull_check) {
       const std::string why = cull_unsafe_reason(set);
       m.cull = why.empty();
-      if (!m.cull) std::fprintf(stderr, "warning: %s: --cull not applied to this mesh: %s\n", set.name.c_str(), why.c_str());
+      if (!m.cull)
+        std::fprintf(stderr, "warning: %s: --cull not applied to this mesh: %s\n", set.name.c_str(), why.c_str());
     }
     m.bs_center = (lo + hi) * 0.5;
     for (const auto& p : set.positions) m.bs_radius = std::max(m.bs_radius, length(p - m.bs_center));
@@ -445,7 +457,8 @@ struct Tracer::Impl {
   void build_bvh(PreparedMesh<T>& m, const TriangleKernels<T>& k, const Vec3d& mesh_lo, const Vec3d& mesh_hi) const {
     const TriangleSet& set = *m.set;
     const std::size_t n = set.triangles.size();
-    const double size = std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
+    const double size =
+        std::max(length(mesh_hi - mesh_lo), std::max(max_component(abs(mesh_lo)), max_component(abs(mesh_hi))));
     // A small mesh (a scene's lone triangle) is built on this thread:
     // starting threads for each of 30,000 would cost more than the builds
     // (the tree is the same for every thread count).
@@ -463,8 +476,10 @@ struct Tracer::Impl {
     if (m.bvh.nodes.size() == 1) {
       int leaves = 0, others = 0;
       for (const std::uint32_t c : m.bvh.nodes[0].child) {
-        if (Bvh::is_leaf(c)) ++leaves, m.one_leaf = c;
-        else others += c != Bvh::kEmpty;
+        if (Bvh::is_leaf(c))
+          ++leaves, m.one_leaf = c;
+        else
+          others += c != Bvh::kEmpty;
       }
       if (leaves != 1 || others != 0) m.one_leaf = Bvh::kEmpty;
     }
@@ -586,7 +601,10 @@ struct Tracer::Impl {
 
   template <class T>
   const std::vector<PreparedMesh<T>>& meshes() const {
-    if constexpr (sizeof(T) == 4) return meshes_f; else return meshes_d;
+    if constexpr (sizeof(T) == 4)
+      return meshes_f;
+    else
+      return meshes_d;
   }
 
   // The closest hit in a mesh of Möller 4-wide leaves (tri4) through its
@@ -596,25 +614,31 @@ struct Tracer::Impl {
   [[gnu::always_inline]] static inline void closest_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& window,
                                                             int oi, bool cull, Consider&& consider) {
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(window);
-    walk_mesh<true, kFma>(m, boxed, window.o, window.d, window.tmin, window.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
-      moller_simd::Hit4<T> h;
-      moller_simd::hit4<kFma>(lanes, window.tmax, m.tri4[first / 4], cull, h);
-      for (int hits = h.hits; hits; hits &= hits - 1) {
-        const int l = __builtin_ctz(unsigned(hits));
-        consider(double(h.t[l]), oi, int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
-      }
-      return false;
-    }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+    walk_mesh<true, kFma>(
+        m, boxed, window.o, window.d, window.tmin, window.tmax,
+        [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+          moller_simd::Hit4<T> h;
+          moller_simd::hit4<kFma>(lanes, window.tmax, m.tri4[first / 4], cull, h);
+          for (int hits = h.hits; hits; hits &= hits - 1) {
+            const int l = __builtin_ctz(unsigned(hits));
+            consider(double(h.t[l]), oi, int(m.bvh.order[first + l]), double(h.b1[l]), double(h.b2[l]));
+          }
+          return false;
+        },
+        [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
   }
   template <bool kFma, class T>
   [[gnu::always_inline]] static inline bool any_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& r) {
     bool hit = false;
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(r);
-    walk_mesh<false, kFma>(m, boxed, r.o, r.d, r.tmin, r.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
-      moller_simd::Hit4<T> h;
-      moller_simd::hit4<kFma>(lanes, r.tmax, m.tri4[first / 4], false, h);  // never culled: see closest()
-      return hit = h.hits != 0;
-    }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+    walk_mesh<false, kFma>(
+        m, boxed, r.o, r.d, r.tmin, r.tmax,
+        [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+          moller_simd::Hit4<T> h;
+          moller_simd::hit4<kFma>(lanes, r.tmax, m.tri4[first / 4], false, h);  // never culled: see closest()
+          return hit = h.hits != 0;
+        },
+        [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
     return hit;
   }
 
@@ -633,19 +657,20 @@ struct Tracer::Impl {
     const auto& m = meshes<T>()[0];
     const double t0 = shift<T>(rd);  // as closest_impl's
     Ray<T> window = t0 != 0 ? moved<T>(rd, t0, rd.tmax) : Ray<T>(rd);
-    closest_in_tri4<true>(m, false, window, 0, cull && m.cull,
-                          [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
-                            if (nearer(t0 + t, obj, prim, best)) {
-                              best = {t0 + t, obj, prim, b1, b2};
-                              window.tmax = T(t);
-                            }
-                          });
+    closest_in_tri4<true>(
+        m, false, window, 0,
+        cull && m.cull, [&](double t, int obj, int prim, double b1, double b2) __attribute__((always_inline)) {
+          if (nearer(t0 + t, obj, prim, best)) {
+            best = {t0 + t, obj, prim, b1, b2};
+            window.tmax = T(t);
+          }
+        });
     if (best.object < 0) return std::nullopt;
     return best;
   }
   template <class T>
   [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_one_mesh_avx2(const Ray<double>& rd,
-                                                                                            bool cull) const {
+                                                                                           bool cull) const {
     return closest_one_mesh<T>(rd, cull);
   }
   template <class T>
@@ -723,12 +748,14 @@ struct Tracer::Impl {
               closest_in_tri4<kFma>(m, boxed, lr, int(oi), cull && m.cull, local);
               break;
             }
-            walk_mesh<true, kFma>(m, boxed, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-              for (std::uint32_t slot = first; slot < first + count; ++slot)
-                if (auto h = k.hit_pre(lr, m.pre.data() + slot * m.stride, cull && m.cull))
-                  local(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
-              return false;
-            });
+            walk_mesh<true, kFma>(
+                m, boxed, lr.o, lr.d, lr.tmin,
+                lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+                  for (std::uint32_t slot = first; slot < first + count; ++slot)
+                    if (auto h = k.hit_pre(lr, m.pre.data() + slot * m.stride, cull && m.cull))
+                      local(double(h->t), int(oi), int(m.bvh.order[slot]), double(h->b1), double(h->b2));
+                  return false;
+                });
             break;
           }
           if (opt.accel == Accel::sphere && !segment_meets_ball(Ray<double>(lr), m.bs_center, m.bs_radius + m.pad))
@@ -758,31 +785,36 @@ struct Tracer::Impl {
         };
         if (!m.tri4.empty()) {
           const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(lr);
-          traverse<true, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
-            moller_simd::Hit4<T> h;
-            moller_simd::hit4<kFma>(lanes, lr.tmax, m.tri4[first / 4], false, h);
-            for (int hits = h.hits; hits; hits &= hits - 1) {
-              const int l = __builtin_ctz(unsigned(hits));
-              local(double(h.t[l]), soup_object[m.bvh.order[first + l]], 0, double(h.b1[l]), double(h.b2[l]));
-            }
-            return false;
-          }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+          traverse<true, kFma>(
+              m.bvh, lr.o, lr.d, lr.tmin, lr.tmax,
+              [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+                moller_simd::Hit4<T> h;
+                moller_simd::hit4<kFma>(lanes, lr.tmax, m.tri4[first / 4], false, h);
+                for (int hits = h.hits; hits; hits &= hits - 1) {
+                  const int l = __builtin_ctz(unsigned(hits));
+                  local(double(h.t[l]), soup_object[m.bvh.order[first + l]], 0, double(h.b1[l]), double(h.b2[l]));
+                }
+                return false;
+              },
+              [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
         } else {
           const auto& k = tri_method->triangle<T>();
-          traverse<true, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-            for (std::uint32_t slot = first; slot < first + count; ++slot)
-              if (auto h = k.hit_pre(lr, m.pre.data() + slot * m.stride, false))
-                local(double(h->t), soup_object[m.bvh.order[slot]], 0, double(h->b1), double(h->b2));
-            return false;
-          });
+          traverse<true, kFma>(
+              m.bvh, lr.o, lr.d, lr.tmin,
+              lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+                for (std::uint32_t slot = first; slot < first + count; ++slot)
+                  if (auto h = k.hit_pre(lr, m.pre.data() + slot * m.stride, false))
+                    local(double(h->t), soup_object[m.bvh.order[slot]], 0, double(h->b1), double(h->b2));
+                return false;
+              });
         }
       }
-      traverse<true, kFma, false>(object_bvh, window.o, window.d, window.tmin, window.tmax,
-                           [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-                             for (std::uint32_t slot = first; slot < first + count; ++slot)
-                               visit(std::size_t(bounded[slot]), true);
-                             return false;
-                           });
+      traverse<true, kFma, false>(
+          object_bvh, window.o, window.d, window.tmin,
+          window.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+            for (std::uint32_t slot = first; slot < first + count; ++slot) visit(std::size_t(bounded[slot]), true);
+            return false;
+          });
     }
     if (best.object < 0) return std::nullopt;
     return best;
@@ -813,7 +845,8 @@ struct Tracer::Impl {
       const auto t = pov_mesh_intersect(r, a, b, c);
       if (!t) return;
       const PovMeshHit ph = pov_mesh_hit(r, a, b, c);
-      found.push_back({box_entry(r, to_float32(a), to_float32(b), to_float32(c)), SceneHit{*t, -1, prim, ph.b1, ph.b2}});
+      found.push_back(
+          {box_entry(r, to_float32(a), to_float32(b), to_float32(c)), SceneHit{*t, -1, prim, ph.b1, ph.b2}});
     };
     if (opt.accel == Accel::bvh) {
       const Ray<double> all{r.o, r.d, 0.0, std::numeric_limits<double>::infinity()};
@@ -853,7 +886,7 @@ struct Tracer::Impl {
   template <class T, bool kFma, bool kObjects = false>
   [[gnu::always_inline]] inline bool occluded_impl(const Ray<T>& r) const {
     // Is object oi in the ray's window?
-    auto visit = [&](std::size_t oi, bool boxed) __attribute__((always_inline)) -> bool {
+    auto visit = [&](std::size_t oi, bool boxed) __attribute__((always_inline))->bool {
       const Object& o = scene.objects[oi];
       switch (o.kind) {
         case Object::Kind::sphere:
@@ -876,16 +909,19 @@ struct Tracer::Impl {
             if (!m.tri4.empty()) {
               hit = any_in_tri4<kFma>(m, boxed, lr);
             } else {
-              walk_mesh<false, kFma>(m, boxed, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-                for (std::uint32_t slot = first; slot < first + count; ++slot)
-                  if (k.any_pre(lr, m.pre.data() + slot * m.stride, false)) return hit = true;
-                return false;
-              });
+              walk_mesh<false, kFma>(
+                  m, boxed, lr.o, lr.d, lr.tmin,
+                  lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+                    for (std::uint32_t slot = first; slot < first + count; ++slot)
+                      if (k.any_pre(lr, m.pre.data() + slot * m.stride, false)) return hit = true;
+                    return false;
+                  });
             }
             if (hit) return true;
             break;
           }
-          if (opt.accel == Accel::sphere && !segment_meets_ball(static_cast<Ray<double>>(lr), m.bs_center, m.bs_radius + m.pad))
+          if (opt.accel == Accel::sphere &&
+              !segment_meets_ball(static_cast<Ray<double>>(lr), m.bs_center, m.bs_radius + m.pad))
             break;
           const std::size_t n = m.set->triangles.size();
           for (std::size_t i = 0; i < n; ++i)
@@ -903,27 +939,33 @@ struct Tracer::Impl {
         const Ray<T> lr = moved_any(r);  // as a mesh's (visit)
         if (!m.tri4.empty()) {
           const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(lr);
-          traverse<false, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
-            moller_simd::Hit4<T> h;
-            moller_simd::hit4<kFma>(lanes, lr.tmax, m.tri4[first / 4], false, h);
-            return hit = h.hits != 0;
-          }, [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
+          traverse<false, kFma>(
+              m.bvh, lr.o, lr.d, lr.tmin, lr.tmax,
+              [&](std::uint32_t first, std::uint32_t) __attribute__((always_inline)) {
+                moller_simd::Hit4<T> h;
+                moller_simd::hit4<kFma>(lanes, lr.tmax, m.tri4[first / 4], false, h);
+                return hit = h.hits != 0;
+              },
+              [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.tri4[first / 4]); });
         } else {
           const auto& k = tri_method->triangle<T>();
-          traverse<false, kFma>(m.bvh, lr.o, lr.d, lr.tmin, lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-            for (std::uint32_t slot = first; slot < first + count; ++slot)
-              if (k.any_pre(lr, m.pre.data() + slot * m.stride, false)) return hit = true;
-            return false;
-          });
+          traverse<false, kFma>(
+              m.bvh, lr.o, lr.d, lr.tmin,
+              lr.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+                for (std::uint32_t slot = first; slot < first + count; ++slot)
+                  if (k.any_pre(lr, m.pre.data() + slot * m.stride, false)) return hit = true;
+                return false;
+              });
         }
         if (hit) return true;
       }
-      traverse<false, kFma, false>(object_bvh, r.o, r.d, r.tmin, r.tmax,
-                            [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-                              for (std::uint32_t slot = first; slot < first + count; ++slot)
-                                if (visit(std::size_t(bounded[slot]), true)) return hit = true;
-                              return false;
-                            });
+      traverse<false, kFma, false>(
+          object_bvh, r.o, r.d, r.tmin,
+          r.tmax, [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+            for (std::uint32_t slot = first; slot < first + count; ++slot)
+              if (visit(std::size_t(bounded[slot]), true)) return hit = true;
+            return false;
+          });
       return hit;
     } else {
       for (std::size_t oi = 0; oi < scene.objects.size(); ++oi)
@@ -946,7 +988,7 @@ struct Tracer::Impl {
   }
   template <class T>
   [[gnu::target("avx2,fma"), gnu::noinline]] std::optional<SceneHit> closest_objects_avx2(const Ray<double>& rd,
-                                                                                           bool cull) const {
+                                                                                          bool cull) const {
     return closest_impl<T, true, true>(rd, -1, cull);
   }
   template <class T>
@@ -972,7 +1014,9 @@ struct Tracer::Impl {
     return avx2 ? closest_avx2<T>(rd, only, cull) : closest_base<T>(rd, only, cull);
   }
   template <class T>
-  [[gnu::noinline]] bool occluded_objects_base(const Ray<T>& r) const { return occluded_impl<T, false, true>(r); }
+  [[gnu::noinline]] bool occluded_objects_base(const Ray<T>& r) const {
+    return occluded_impl<T, false, true>(r);
+  }
   template <class T>
   [[gnu::target("avx2,fma"), gnu::noinline]] bool occluded_objects_avx2(const Ray<T>& r) const {
     return occluded_impl<T, true, true>(r);
@@ -1114,8 +1158,7 @@ struct Tracer::Impl {
   Color pigment(const Surface& s) const {
     const Material& m = *s.material;
     if (m.texture && s.has_uv)
-      if (const Texture* t = textures.find(m.texture->file))
-        return t->sample(s.u, s.v, m.texture->filter);
+      if (const Texture* t = textures.find(m.texture->file)) return t->sample(s.u, s.v, m.texture->filter);
     return m.color;
   }
 
@@ -1176,10 +1219,9 @@ struct Tracer::Impl {
   }
 
   Ray<double> reflected_ray(const Surface& s, const Vec3d& dir) const {
-    if (opt.use_double)
-      return spawn_ray<double>(opt.self_intersection, s.p, s.p_error, s.ng, dir, false, 0.0);
-    const Ray<float> r = spawn_ray<float>(opt.self_intersection, Vec3f(s.p), Vec3f(s.p_error), Vec3f(s.ng),
-                                          Vec3f(dir), false, 0.f);
+    if (opt.use_double) return spawn_ray<double>(opt.self_intersection, s.p, s.p_error, s.ng, dir, false, 0.0);
+    const Ray<float> r =
+        spawn_ray<float>(opt.self_intersection, Vec3f(s.p), Vec3f(s.p_error), Vec3f(s.ng), Vec3f(dir), false, 0.f);
     return Ray<double>{Vec3d(r.o), dir, double(r.tmin), std::numeric_limits<double>::infinity()};
   }
 
@@ -1326,11 +1368,17 @@ struct Tracer::Impl {
 
   template <bool F32>
   static Color round_colour(const Color& x) {
-    if constexpr (F32) return to_float32(x); else return x;
+    if constexpr (F32)
+      return to_float32(x);
+    else
+      return x;
   }
   template <bool F32>
   static double round_scalar(double x) {
-    if constexpr (F32) return to_float32(x); else return x;
+    if constexpr (F32)
+      return to_float32(x);
+    else
+      return x;
   }
 
   // POV's TraceRay. `level`: the trace level of the surface this ray meets
@@ -1372,8 +1420,7 @@ struct Tracer::Impl {
     const Color rmax = f(m.reflection);
     Color reflec = rmax;
     if (m.fresnel)
-      if (const auto F = glass::fresnel(glass::relative_ior(interiors, s.object, ior_of), cos_i))
-        reflec = f(rmax * *F);
+      if (const auto F = glass::fresnel(glass::relative_ior(interiors, s.object, ior_of), cos_i)) reflec = f(rmax * *F);
     const double rweight = weight * max_component(reflec);
     // Ambient, then each light's diffuse and phong, as POV sums them.
     Color out = f(f(mul(f(mul(c, f(m.ambient))), f(scene.ambient_light))) * att);
@@ -1406,8 +1453,9 @@ struct Tracer::Impl {
     Color filcol = glass::rgb_transm(c, fil, tr);
     if constexpr (F32) filcol = f(Color{fs(fs(c.x * fil) + tr), fs(fs(c.y * fil) + tr), fs(fs(c.z * fil) + tr)});
     if (m.fresnel)
-      filcol = f(mul(filcol, f(Color{std::min(1.0, 1.0 - reflec.x), std::min(1.0, 1.0 - reflec.y),
-                                     std::min(1.0, 1.0 - reflec.z)})));
+      filcol =
+          f(mul(filcol,
+                f(Color{std::min(1.0, 1.0 - reflec.x), std::min(1.0, 1.0 - reflec.y), std::min(1.0, 1.0 - reflec.z)})));
     const double trans = std::min(1.0, std::abs(fs(glass::greyscale(filcol))));
     const Vec3d refl_dir = pov_normalize(refl);
     bool tir = false;
@@ -1467,7 +1515,8 @@ struct Tracer::Impl {
       Color pass = glass::rgb_transm(c, fil, tr);
       if constexpr (F32) pass = Color{fs(fs(c.x * fil) + tr), fs(fs(c.y * fil) + tr), fs(fs(c.z * fil) + tr)};
       lc = f(mul(lc, pass));
-      if (!(std::abs(lc.x) >= glass::kEpsilon || std::abs(lc.y) >= glass::kEpsilon || std::abs(lc.z) >= glass::kEpsilon))
+      if (!(std::abs(lc.x) >= glass::kEpsilon || std::abs(lc.y) >= glass::kEpsilon ||
+            std::abs(lc.z) >= glass::kEpsilon))
         return {0, 0, 0};
       through = true;
       depth -= h->t;
@@ -1497,8 +1546,7 @@ struct Tracer::Impl {
   }
 };
 
-Tracer::Tracer(const Scene& scene, const RenderOptions& options)
-    : impl_(std::make_unique<Impl>(scene, options)) {}
+Tracer::Tracer(const Scene& scene, const RenderOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {}
 Tracer::~Tracer() = default;
 
 Color Tracer::trace(const Ray<double>& ray) const { return impl_->trace(ray, 1, 1.0); }
@@ -1554,20 +1602,21 @@ Image Tracer::render() const {
   std::atomic<bool> finished{false};
   std::thread reporter;
   if (show) try {
-    reporter = std::thread([&] {
-      bool printed = false;
-      while (!finished.load() && done.load() < tiles) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (secs > 0.5 && !finished.load()) {
-          std::fprintf(stderr, "\rrendering %dx%d: %3d%% (%.1f s)", s.width, s.height, 100 * done.load() / tiles, secs);
-          printed = true;
+      reporter = std::thread([&] {
+        bool printed = false;
+        while (!finished.load() && done.load() < tiles) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          if (secs > 0.5 && !finished.load()) {
+            std::fprintf(stderr, "\rrendering %dx%d: %3d%% (%.1f s)", s.width, s.height, 100 * done.load() / tiles,
+                         secs);
+            printed = true;
+          }
         }
-      }
-      if (printed) std::fprintf(stderr, "\r\033[K");
-    });
-  } catch (const std::system_error&) {
-  }
+        if (printed) std::fprintf(stderr, "\r\033[K");
+      });
+    } catch (const std::system_error&) {
+    }
   run_workers(threads, worker);
   finished = true;
   if (reporter.joinable()) reporter.join();

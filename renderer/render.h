@@ -19,13 +19,13 @@ const char* accel_name(Accel a);
 struct RenderOptions {
   std::string triangle_method = "moller";
   std::string sphere_method = "stable";
-  bool use_double = true;  // intersection precision; shading is always double
-  bool cull = false;       // backface culling for triangles (document 002)
+  bool use_double = true;    // intersection precision; shading is always double
+  bool cull = false;         // backface culling for triangles (document 002)
   Accel accel = Accel::bvh;  // none and sphere are document 002's; bvh the modern reference
   SelfIntersection self_intersection = SelfIntersection::pov;
-  int threads = 0;          // 0: all cores
-  int samples_per_axis = 1; // n x n samples per pixel, averaged
-  bool progress = true;     // a progress line on a terminal (stderr)
+  int threads = 0;           // 0: all cores
+  int samples_per_axis = 1;  // n x n samples per pixel, averaged
+  bool progress = true;      // a progress line on a terminal (stderr)
   // With accel bvh, a scene of 3 or more spheres and meshes finds them
   // through a BVH over their boxes (POV-Ray's automatic bounding); false:
   // a loop over every object. The same image either way (render_test).
@@ -137,8 +137,6 @@ class Tracer {
   std::unique_ptr<Impl> impl_;
 };
 
-inline Image render(const Scene& scene, const RenderOptions& options) {
-  return Tracer(scene, options).render();
-}
+inline Image render(const Scene& scene, const RenderOptions& options) { return Tracer(scene, options).render(); }
 
 }  // namespace ra

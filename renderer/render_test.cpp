@@ -78,9 +78,16 @@ TEST(Intersect, PlaneFromBothSidesAndParallel) {
   auto below = tr.intersect({{3, -1, 0}, {0, 1, 0}});
   ASSERT_TRUE(below);
   EXPECT_DOUBLE_EQ(below->t, 2.0);
-  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {1, 0, 0}}));   // parallel
-  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {0, 1, 0}}));   // plane behind
-  EXPECT_FALSE(tr.intersect({{0, 5, 0, }, {0, -1, 0}, 0, 3.9}));  // beyond tmax
+  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {1, 0, 0}}));  // parallel
+  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {0, 1, 0}}));  // plane behind
+  EXPECT_FALSE(tr.intersect({{
+                                 0,
+                                 5,
+                                 0,
+                             },
+                             {0, -1, 0},
+                             0,
+                             3.9}));  // beyond tmax
 }
 
 TEST(Intersect, TriangleAndTheNearestObjectWins) {
@@ -100,7 +107,8 @@ TEST(Intersect, TriangleAndTheNearestObjectWins) {
 // A grey plane y = 0 seen along a ray that hits the origin.
 std::string lit_plane(const std::string& light, const std::string& extra_material = "") {
   return R"({"lights": [)" + light + R"(], "objects": [{"plane": {"normal": [0,1,0], "offset": 0},
-      "material": {"color": [0.5, 0.5, 0.5])" + extra_material + "}}]}";
+      "material": {"color": [0.5, 0.5, 0.5])" +
+         extra_material + "}}]}";
 }
 
 TEST(Shading, AmbientOnlyWithoutLights) {
@@ -124,8 +132,8 @@ TEST(Shading, PhongIsNotTintedByThePigment) {
   // (1,1,0)/sqrt2, which points exactly at the light: R.L = 1, so phong adds
   // 0.5 * 1^2 * Lc = 0.5 in every channel, whatever the pigment; diffuse adds
   // 0.6 * (1/sqrt2) * C * Lc with light colour (1, 0.5, 0.25).
-  Scene s = parse(lit_plane(R"({"position": [10, 10, 0], "color": [1, 0.5, 0.25]})",
-                            R"(, "phong": 0.5, "phong_size": 2)"));
+  Scene s =
+      parse(lit_plane(R"({"position": [10, 10, 0], "color": [1, 0.5, 0.25]})", R"(, "phong": 0.5, "phong_size": 2)"));
   Tracer tr(s, opts());
   const double diff = 0.6 / std::sqrt(2.0) * 0.5;
   expect_color(tr.trace({{-1, 1, 0}, Vec3d{1, -1, 0}}),
@@ -203,7 +211,8 @@ TEST(Render, ImageIsIdenticalForAnyThreadCount) {
 TEST(Render, SupersamplingAveragesTheSubpixelCentres) {
   // A 1x1 image whose pixel straddles the sphere's silhouette: the 2x2
   // average equals the mean of the four sub-pixel traces.
-  Scene s = parse(R"({"width": 1, "height": 1, "lights": [], "camera": {"position": [1, 1, 5], "look_at": [1, 1, 0], "vfov": 30},
+  Scene s = parse(
+      R"({"width": 1, "height": 1, "lights": [], "camera": {"position": [1, 1, 5], "look_at": [1, 1, 0], "vfov": 30},
       "objects": [{"sphere": {"center": [0,0,0], "radius": 1.414}, "material": {"ambient": 1}}]})");
   RenderOptions o = opts();
   o.samples_per_axis = 2;
@@ -218,7 +227,6 @@ TEST(Render, SupersamplingAveragesTheSubpixelCentres) {
     }
   expect_color(tr.pixel(0, 0), sum / 4.0);
 }
-
 
 // In float, normal-offset must move a secondary ray's origin by float's
 // error bound for the hit point, not double's: on a triangle 1e4 across seen

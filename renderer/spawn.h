@@ -26,10 +26,14 @@ inline std::optional<SelfIntersection> parse_self_intersection(std::string_view 
 }
 inline const char* self_intersection_name(SelfIntersection s) {
   switch (s) {
-    case SelfIntersection::eps: return "eps";
-    case SelfIntersection::pov: return "pov";
-    case SelfIntersection::normal_offset: return "normal-offset";
-    case SelfIntersection::ulp_offset: return "ulp-offset";
+    case SelfIntersection::eps:
+      return "eps";
+    case SelfIntersection::pov:
+      return "pov";
+    case SelfIntersection::normal_offset:
+      return "normal-offset";
+    case SelfIntersection::ulp_offset:
+      return "ulp-offset";
   }
   return "?";
 }
@@ -45,16 +49,20 @@ inline constexpr double kPovMinIsectDepth = 1e-4;
 namespace detail {
 
 // gamma(n) = n u / (1 - n u), the bound of n successive roundings (pbrt-v4).
-template <class T> constexpr T gamma(int n) {
+template <class T>
+constexpr T gamma(int n) {
   constexpr T u = std::numeric_limits<T>::epsilon() * T(0.5);
   return (n * u) / (1 - n * u);
 }
 
 // Moves every component of po one ulp along the sign of `dir` (none where it is 0).
-template <class T> Vec3<T> step_outward(Vec3<T> po, const Vec3<T>& dir) {
+template <class T>
+Vec3<T> step_outward(Vec3<T> po, const Vec3<T>& dir) {
   for (int i = 0; i < 3; ++i) {
-    if (dir[i] > 0) po[i] = std::nextafter(po[i], std::numeric_limits<T>::infinity());
-    else if (dir[i] < 0) po[i] = std::nextafter(po[i], -std::numeric_limits<T>::infinity());
+    if (dir[i] > 0)
+      po[i] = std::nextafter(po[i], std::numeric_limits<T>::infinity());
+    else if (dir[i] < 0)
+      po[i] = std::nextafter(po[i], -std::numeric_limits<T>::infinity());
   }
   return po;
 }
@@ -65,7 +73,8 @@ template <class T> Vec3<T> step_outward(Vec3<T> po, const Vec3<T>& dir) {
 // chapter is written for float; for double the integer step is scaled by
 // 2^29 (the difference in mantissa bits) so the offset keeps the same
 // relative size, which is conservative for double's smaller rounding.
-template <class T> Vec3<T> ulp_offset(const Vec3<T>& p, const Vec3<T>& n) {
+template <class T>
+Vec3<T> ulp_offset(const Vec3<T>& p, const Vec3<T>& n) {
   constexpr T origin = T(1) / T(32);
   constexpr T float_scale = T(1) / T(65536);
   Vec3<T> r;
@@ -99,8 +108,8 @@ template <class T> Vec3<T> ulp_offset(const Vec3<T>& p, const Vec3<T>& n) {
 //  shadow: a shadow ray toward a light at distance light_distance from p
 //     (tmax ends before the light); otherwise tmax is infinite.
 template <class T>
-Ray<T> spawn_ray(SelfIntersection s, const Vec3<T>& p, const Vec3<T>& p_error, Vec3<T> n,
-                 const Vec3<T>& dir, bool shadow, T light_distance) {
+Ray<T> spawn_ray(SelfIntersection s, const Vec3<T>& p, const Vec3<T>& p_error, Vec3<T> n, const Vec3<T>& dir,
+                 bool shadow, T light_distance) {
   if (dot(n, dir) < 0) n = -n;
   const T inf = std::numeric_limits<T>::infinity();
   switch (s) {

@@ -30,15 +30,16 @@ namespace ra {
 namespace {
 
 // p moved k representable values towards +inf (k > 0) or -inf (k < 0).
-template <class T> T steps(T p, long long k) {
+template <class T>
+T steps(T p, long long k) {
   const T to = k > 0 ? std::numeric_limits<T>::infinity() : -std::numeric_limits<T>::infinity();
   for (long long i = 0; i < std::llabs(k); ++i) p = std::nextafter(p, to);
   return p;
 }
 
 TEST(Spawn, NamesRoundTrip) {
-  for (auto s : {SelfIntersection::eps, SelfIntersection::pov, SelfIntersection::normal_offset,
-                 SelfIntersection::ulp_offset})
+  for (auto s :
+       {SelfIntersection::eps, SelfIntersection::pov, SelfIntersection::normal_offset, SelfIntersection::ulp_offset})
     EXPECT_EQ(parse_self_intersection(self_intersection_name(s)), s);
   EXPECT_FALSE(parse_self_intersection("ulp"));
   EXPECT_FALSE(parse_self_intersection(""));
@@ -68,8 +69,8 @@ TEST(Spawn, PovUsesPovRaysWindows) {
   EXPECT_EQ(s.tmin, 1e-3);
   EXPECT_EQ(s.tmax, 7.0 - 1e-3);
   // Float rays get the same windows, rounded to float.
-  const Ray<float> f = spawn_ray(SelfIntersection::pov, Vec3f{1, 2, 3}, Vec3f{}, Vec3f{0, 0, 1},
-                                 Vec3f{0, 0, 1}, true, 5.0f);
+  const Ray<float> f =
+      spawn_ray(SelfIntersection::pov, Vec3f{1, 2, 3}, Vec3f{}, Vec3f{0, 0, 1}, Vec3f{0, 0, 1}, true, 5.0f);
   EXPECT_EQ(f.tmin, 1e-3f);
   EXPECT_EQ(f.tmax, 5.0f - 1e-3f);
 }
@@ -92,7 +93,7 @@ TEST(Spawn, UlpOffsetFloatMovesByInt256NUlpsAndSmallComponentsByNOver65536) {
 TEST(Spawn, UlpOffsetCrossesBinadesOneRepresentableValueAtATime) {
   // 1.0 moved down: the ulps below 1 are 2^-24, half those above.
   const Vec3f o = detail::ulp_offset(Vec3f{1.0f, -1.0f, 0.5f}, Vec3f{-0.6f, 0.8f, 0.0f});
-  EXPECT_EQ(o.x, 1.0f - 153 * 0x1p-24f);  // int(-153.6) = -153
+  EXPECT_EQ(o.x, 1.0f - 153 * 0x1p-24f);   // int(-153.6) = -153
   EXPECT_EQ(o.y, -1.0f + 204 * 0x1p-24f);  // int(204.8) = 204, towards zero
   EXPECT_EQ(o.z, 0.5f);                    // n.z = 0: no move
   // |p| exactly 1/32 is not "within 1/32": it moves in ulps.
@@ -231,8 +232,8 @@ TEST(Spawn, NoStrategyShadowsAFlatTriangleOnItself) {
       "objects": [{"triangle": [[-1, -1, 0], [1, -1, 0], [0, 1, 0]],
                    "material": {"ambient": 0, "diffuse": 1}}]})";
   const Scene scene = load_scene(dir / "flat.json");
-  for (auto s : {SelfIntersection::eps, SelfIntersection::pov, SelfIntersection::normal_offset,
-                 SelfIntersection::ulp_offset})
+  for (auto s :
+       {SelfIntersection::eps, SelfIntersection::pov, SelfIntersection::normal_offset, SelfIntersection::ulp_offset})
     for (bool dbl : {true, false}) {
       RenderOptions o;
       o.progress = false;

@@ -23,32 +23,73 @@ struct Vec3 {
   constexpr Vec3 operator-() const { return {-x, -y, -z}; }
   constexpr Vec3 operator*(T s) const { return {x * s, y * s, z * s}; }
   constexpr Vec3 operator/(T s) const { return {x / s, y / s, z / s}; }
-  constexpr Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
-  constexpr Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  constexpr Vec3& operator*=(T s) { x *= s; y *= s; z *= s; return *this; }
+  constexpr Vec3& operator+=(const Vec3& o) {
+    x += o.x;
+    y += o.y;
+    z += o.z;
+    return *this;
+  }
+  constexpr Vec3& operator-=(const Vec3& o) {
+    x -= o.x;
+    y -= o.y;
+    z -= o.z;
+    return *this;
+  }
+  constexpr Vec3& operator*=(T s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+  }
   constexpr bool operator==(const Vec3& o) const = default;
 };
 
-template <class T> constexpr Vec3<T> operator*(T s, const Vec3<T>& v) { return v * s; }
-template <class T> constexpr T dot(const Vec3<T>& a, const Vec3<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-template <class T> constexpr Vec3<T> cross(const Vec3<T>& a, const Vec3<T>& b) {
+template <class T>
+constexpr Vec3<T> operator*(T s, const Vec3<T>& v) {
+  return v * s;
+}
+template <class T>
+constexpr T dot(const Vec3<T>& a, const Vec3<T>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <class T>
+constexpr Vec3<T> cross(const Vec3<T>& a, const Vec3<T>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-template <class T> constexpr Vec3<T> mul(const Vec3<T>& a, const Vec3<T>& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-template <class T> T length(const Vec3<T>& v) { return std::sqrt(dot(v, v)); }
-template <class T> Vec3<T> normalize(const Vec3<T>& v) { return v / length(v); }
-template <class T> Vec3<T> abs(const Vec3<T>& v) { return {std::abs(v.x), std::abs(v.y), std::abs(v.z)}; }
-template <class T> Vec3<T> vmin(const Vec3<T>& a, const Vec3<T>& b) {
+template <class T>
+constexpr Vec3<T> mul(const Vec3<T>& a, const Vec3<T>& b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+template <class T>
+T length(const Vec3<T>& v) {
+  return std::sqrt(dot(v, v));
+}
+template <class T>
+Vec3<T> normalize(const Vec3<T>& v) {
+  return v / length(v);
+}
+template <class T>
+Vec3<T> abs(const Vec3<T>& v) {
+  return {std::abs(v.x), std::abs(v.y), std::abs(v.z)};
+}
+template <class T>
+Vec3<T> vmin(const Vec3<T>& a, const Vec3<T>& b) {
   return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }
-template <class T> Vec3<T> vmax(const Vec3<T>& a, const Vec3<T>& b) {
+template <class T>
+Vec3<T> vmax(const Vec3<T>& a, const Vec3<T>& b) {
   return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
-template <class T> T max_component(const Vec3<T>& v) { return std::max(v.x, std::max(v.y, v.z)); }
-template <class T> int max_dimension(const Vec3<T>& v) {
+template <class T>
+T max_component(const Vec3<T>& v) {
+  return std::max(v.x, std::max(v.y, v.z));
+}
+template <class T>
+int max_dimension(const Vec3<T>& v) {
   return (v.x > v.y) ? (v.x > v.z ? 0 : 2) : (v.y > v.z ? 1 : 2);
 }
-template <class T> std::ostream& operator<<(std::ostream& os, const Vec3<T>& v) {
+template <class T>
+std::ostream& operator<<(std::ostream& os, const Vec3<T>& v) {
   return os << '(' << v.x << ", " << v.y << ", " << v.z << ')';
 }
 

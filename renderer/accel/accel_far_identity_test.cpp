@@ -71,8 +71,8 @@ struct Counts {
 // Rays from `from` (each jittered by `jitter`) to random points of the
 // sphere's silhouette disc and a little beyond it; every accel must answer
 // as none does. Returns the hits none found.
-void compare(const Scene& scene, const Method& m, bool dbl, const Vec3d& c, double r, const Vec3d& from,
-             double jitter, int rays, std::uint64_t seed, Counts& counts) {
+void compare(const Scene& scene, const Method& m, bool dbl, const Vec3d& c, double r, const Vec3d& from, double jitter,
+             int rays, std::uint64_t seed, Counts& counts) {
   RenderOptions o;
   o.triangle_method = m.name;
   o.use_double = dbl;
@@ -102,7 +102,8 @@ void compare(const Scene& scene, const Method& m, bool dbl, const Vec3d& c, doub
       ++counts.hits;
       for (const auto& x : {b, s, e})
         ASSERT_TRUE(a->t == x->t && a->prim == x->prim && a->b1 == x->b1 && a->b2 == x->b2)
-            << what << " ray " << i << ": t " << a->t << " vs " << x->t << ", triangle " << a->prim << " vs " << x->prim;
+            << what << " ray " << i << ": t " << a->t << " vs " << x->t << ", triangle " << a->prim << " vs "
+            << x->prim;
     }
     const bool occ = none.occluded(ray);
     ASSERT_EQ(occ, bvh.occluded(ray)) << what << " ray " << i << " bvh any-hit";
@@ -151,7 +152,8 @@ TEST_P(AccelFar, SameHitsForMeshesFarOutAndScaled) {
       for (const bool dbl : {false, true})
         for (const double away : {2.0, 1e3, 1e5}) {
           Counts n;
-          compare(scene, m, dbl, c, scale, c + Vec3d{0.6, -0.7, 0.4} * (away * scale), 0.5 * away * scale, 60, ++seed, n);
+          compare(scene, m, dbl, c, scale, c + Vec3d{0.6, -0.7, 0.4} * (away * scale), 0.5 * away * scale, 60, ++seed,
+                  n);
           if (HasFatalFailure()) return;
         }
     }

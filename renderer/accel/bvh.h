@@ -60,14 +60,14 @@ struct alignas(64) BvhNode {
 struct Bvh {
   static constexpr int kWidth = 8;  // children per node
   static constexpr int kBins = 16;
-  static constexpr int kMaxLeaf = 4;       // triangles per leaf; every leaf owns 4 slots
-  static constexpr int kMaxDepth = 128;    // binary depth bound (build); 8-wide depth is below it
+  static constexpr int kMaxLeaf = 4;     // triangles per leaf; every leaf owns 4 slots
+  static constexpr int kMaxDepth = 128;  // binary depth bound (build); 8-wide depth is below it
   static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
-  static constexpr std::uint32_t kLeaf = 0x80000000u;      // child word: leaf flag
+  static constexpr std::uint32_t kLeaf = 0x80000000u;        // child word: leaf flag
   static constexpr std::uint32_t kNoTriangle = 0xFFFFFFFFu;  // order[] of an unused slot
   static constexpr float kRelSlack = 1.0f / (1 << 20);
 
-  std::vector<BvhNode> nodes;       // nodes[0] is the root (empty for an empty mesh)
+  std::vector<BvhNode> nodes;        // nodes[0] is the root (empty for an empty mesh)
   std::vector<std::uint32_t> order;  // slot -> triangle; leaf k's slots are 4k .. 4k + count - 1
   // A hint for the traversal, not part of the tree (build leaves it false):
   // ask for the nodes and leaves either side in memory of every one asked
@@ -163,10 +163,10 @@ inline float above(double x) {
 constexpr unsigned plane_offset(int signs, int a, bool near) {
   return unsigned(((((signs >> a) & 1) != 0) == near ? offsetof(BvhNode, hi) : offsetof(BvhNode, lo)) + 32 * a);
 }
-#define RA_PLANES(s)                                                                                  \
-  {                                                                                                   \
-    plane_offset(s, 0, true), plane_offset(s, 1, true), plane_offset(s, 2, true),                     \
-        plane_offset(s, 0, false), plane_offset(s, 1, false), plane_offset(s, 2, false)               \
+#define RA_PLANES(s)                                                                                         \
+  {                                                                                                          \
+    plane_offset(s, 0, true), plane_offset(s, 1, true), plane_offset(s, 2, true), plane_offset(s, 0, false), \
+        plane_offset(s, 1, false), plane_offset(s, 2, false)                                                 \
   }
 inline constexpr unsigned kPlanes[8][6] = {RA_PLANES(0), RA_PLANES(1), RA_PLANES(2), RA_PLANES(3),
                                            RA_PLANES(4), RA_PLANES(5), RA_PLANES(6), RA_PLANES(7)};
@@ -176,7 +176,7 @@ inline constexpr unsigned kPlanes[8][6] = {RA_PLANES(0), RA_PLANES(1), RA_PLANES
 // broadcast from memory costs a load; eleven 8-lane copies per ray cost
 // more than the boxes a missing ray tests).
 struct BoxRay {
-  v4f o, inv;  // lanes x, y, z (and 0, 1)
+  v4f o, inv;              // lanes x, y, z (and 0, 1)
   const unsigned* planes;  // kPlanes row: near_off[3], far_off[3]
   float tmin;
   bool exact = true;  // false: float cannot hold this ray; visit every leaf
@@ -204,8 +204,10 @@ template <class T>
   // Bit a set: d_a is exactly zero (either sign), tested on T's bits (a
   // compare would cost a NaN-safe sequence of 6 instructions per axis).
   auto zero = [](T x) __attribute__((always_inline)) {
-    if constexpr (sizeof(T) == 8) return (std::bit_cast<std::uint64_t>(x) << 1) == 0;
-    else return (std::bit_cast<std::uint32_t>(x) << 1) == 0;
+    if constexpr (sizeof(T) == 8)
+      return (std::bit_cast<std::uint64_t>(x) << 1) == 0;
+    else
+      return (std::bit_cast<std::uint32_t>(x) << 1) == 0;
   };
   const int dz = int(zero(d.x)) | int(zero(d.y)) << 1 | int(zero(d.z)) << 2;
   const v4 abs_d = (v4)((v4m)df & 0x7FFFFFFF), abs_inv = (v4)((v4m)inv & 0x7FFFFFFF),
@@ -497,8 +499,10 @@ template <bool kFused, bool kNeighbours, class T, class Leaf, class LeafPrefetch
   const float prune_scale = r.nonneg ? 1 + 4 * Bvh::kRelSlack : 1.f;
   const float prune_add = kFused ? r.abs_slack : 0.f;
   auto prune_of = [&](float t) __attribute__((always_inline)) {
-    if constexpr (kFused) return __builtin_fmaf(t, prune_scale, prune_add);
-    else return t * prune_scale;
+    if constexpr (kFused)
+      return __builtin_fmaf(t, prune_scale, prune_add);
+    else
+      return t * prune_scale;
   };
   float prune = prune_of(tmax_f);
   const BoxRay8 r8 = widen(r);
@@ -517,15 +521,19 @@ template <bool kFused, bool kNeighbours, class T, class Leaf, class LeafPrefetch
       if constexpr (!kFused) __builtin_memcpy(tn_mem, &tnv, sizeof tn_mem);
       // Child k's tnear.
       auto tn = [&](int k) __attribute__((always_inline)) {
-        if constexpr (kFused) return lane_avx(tnv, k);
-        else return tn_mem[k];
+        if constexpr (kFused)
+          return lane_avx(tnv, k);
+        else
+          return tn_mem[k];
       };
       if (mask) {
         // Ask for every child met now: its node's lines, or its leaf's data.
         for (int m = mask; m; m &= m - 1) {
           const std::uint32_t c = n.child[__builtin_ctz(unsigned(m))];
-          if (Bvh::is_leaf(c)) prefetch_leaf<kNeighbours>(leaf_prefetch, Bvh::leaf_first(c), slots);
-          else prefetch_node<kNeighbours>(bvh, c, node_count);
+          if (Bvh::is_leaf(c))
+            prefetch_leaf<kNeighbours>(leaf_prefetch, Bvh::leaf_first(c), slots);
+          else
+            prefetch_node<kNeighbours>(bvh, c, node_count);
         }
         const int i = __builtin_ctz(unsigned(mask));
         mask &= mask - 1;

@@ -77,7 +77,7 @@ void compare(const Vec3d& at, double far, std::uint64_t seed, int* hits) {
       r.o = i % 3 == 0 ? at + Vec3d{u(rng), u(rng), u(rng)} * far : at + Vec3d{u(rng), u(rng), u(rng)};
       r.d = target - r.o;
       if (i % 4 == 1) r.o[i % 3] = at[i % 3];  // origin on a plane of the flat triangles
-      if (i % 5 == 2) {                          // axis-parallel
+      if (i % 5 == 2) {                        // axis-parallel
         r.d = Vec3d{0, 0, 0};
         r.d[i % 3] = (i & 8) ? -1 : 1;
         r.o[i % 3] = at[i % 3] - r.d[i % 3] * 3;
@@ -164,7 +164,7 @@ TEST(Bvh, AboveIsNeverBelowItsArgument) {
   std::uniform_int_distribution<int> ex(-160, 127);  // below -FLT_MAX: -inf + inf, a NaN (an empty window)
   for (int i = 0; i < 200000; ++i) {
     double x = std::ldexp(mant(rng), ex(rng));
-    if (i % 3 == 0) x = double(float(x));         // exactly a float
+    if (i % 3 == 0) x = double(float(x));        // exactly a float
     if (i % 5 == 0) x = std::nextafter(x, 0.0);  // just below one
     if (i % 2) x = -x;
     const float a = bvh_detail::above(x);
@@ -191,7 +191,7 @@ TEST(Bvh, FusedBoxTestNeverRejectsABoxTheSegmentMeets) {
     const double scale = i % 3 == 0 ? 1 : i % 3 == 1 ? 1e3 : 1e5;
     const Vec3d o = Vec3d{u(rng), u(rng), u(rng)} * scale;
     Vec3d d{u(rng), u(rng), u(rng)};
-    if (i % 5 == 1) d[i % 3] *= 1e-6;                  // nearly axis-parallel
+    if (i % 5 == 1) d[i % 3] *= 1e-6;                // nearly axis-parallel
     if (i % 7 == 2) d = d * (i % 2 ? 1e-12 : 1e12);  // tiny and huge |d|
     const double tmin = i % 4 == 0 ? 0 : w(rng) * 1e-3 * scale / length(d);
     const double tmax = i % 6 == 0 ? INFINITY : (0.5 + 2 * w(rng)) * scale / length(d);

@@ -5,7 +5,8 @@
 namespace ra {
 
 const TriangleRun& Mesh::run_of(std::size_t i) const {
-  auto it = std::upper_bound(runs.begin(), runs.end(), i, [](std::size_t x, const TriangleRun& r) { return x < r.first; });
+  auto it =
+      std::upper_bound(runs.begin(), runs.end(), i, [](std::size_t x, const TriangleRun& r) { return x < r.first; });
   return *(it - 1);
 }
 

@@ -86,7 +86,7 @@ struct MtlMaterial {
   // Where map_Kd and map_bump were named ("m.mtl:7: map_Kd 'tex.png'"), for errors
   // met when the image is read later.
   std::string map_Kd_at, map_bump_at;
-  std::string Ka_at;  // "m.mtl:3: Ka": where Ka was given, for warnings about it
+  std::string Ka_at;           // "m.mtl:3: Ka": where Ka was given, for warnings about it
   double bump_multiplier = 1;  // `-bm` of the bump map
 };
 

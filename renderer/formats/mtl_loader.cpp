@@ -225,9 +225,11 @@ struct MtlParser {
     if (kw(k, p, "map_Kd")) return map(m.map_Kd, p, se, line, false, &m.map_Kd_at, {k, size_t(p - k)});
     if (kw(k, p, "map_Ks")) return map(m.map_Ks, p, se, line, false);
     if (kw(k, p, "map_d")) return map(m.map_d, p, se, line, false);
-    if (kw(k, p, "map_bump") || kw(k, p, "bump")) return map(m.map_bump, p, se, line, true, &m.map_bump_at, {k, size_t(p - k)});
+    if (kw(k, p, "map_bump") || kw(k, p, "bump"))
+      return map(m.map_bump, p, se, line, true, &m.map_bump_at, {k, size_t(p - k)});
     const std::string key(k, p);
-    if (unknown.insert(key).second) unsupported.add(line, located(name, line, "unsupported MTL statement '" + key + "' ignored"));
+    if (unknown.insert(key).second)
+      unsupported.add(line, located(name, line, "unsupported MTL statement '" + key + "' ignored"));
   }
 };
 

@@ -42,7 +42,7 @@ TEST(Mtl, AllScalarAndColourStatements) {
   EXPECT_EQ(m[0].d, 0.25);
   EXPECT_EQ(m[0].illum, 3);
   EXPECT_EQ(m[1].name, "second");
-  EXPECT_EQ(m[1].d, 1 - 0.2);           // Tr is 1 - d
+  EXPECT_EQ(m[1].d, 1 - 0.2);                // Tr is 1 - d
   EXPECT_EQ(m[1].Kd, Vec3d(0.8, 0.8, 0.8));  // defaults
   EXPECT_EQ(m[1].illum, 2);
 }

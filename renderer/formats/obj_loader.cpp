@@ -79,15 +79,24 @@ Kw classify(const char* p, const char* e) {
       if (n == 1) return Kw::V;
       if (n == 2) return p[1] == 't' ? Kw::VT : p[1] == 'n' ? Kw::VN : p[1] == 'p' ? Kw::VP : Kw::Other;
       return Kw::Other;
-    case 'f': return n == 1 ? Kw::F : Kw::Other;
-    case 'l': return n == 1 ? Kw::L : Kw::Other;
-    case 'p': return n == 1 ? Kw::P : Kw::Other;
-    case 'o': return n == 1 ? Kw::O : Kw::Other;
-    case 'g': return n == 1 ? Kw::G : Kw::Other;
-    case 's': return n == 1 ? Kw::S : Kw::Other;
-    case 'u': return n == 6 && std::memcmp(p, "usemtl", 6) == 0 ? Kw::Usemtl : Kw::Other;
-    case 'm': return n == 6 && std::memcmp(p, "mtllib", 6) == 0 ? Kw::Mtllib : Kw::Other;
-    default: return Kw::Other;
+    case 'f':
+      return n == 1 ? Kw::F : Kw::Other;
+    case 'l':
+      return n == 1 ? Kw::L : Kw::Other;
+    case 'p':
+      return n == 1 ? Kw::P : Kw::Other;
+    case 'o':
+      return n == 1 ? Kw::O : Kw::Other;
+    case 'g':
+      return n == 1 ? Kw::G : Kw::Other;
+    case 's':
+      return n == 1 ? Kw::S : Kw::Other;
+    case 'u':
+      return n == 6 && std::memcmp(p, "usemtl", 6) == 0 ? Kw::Usemtl : Kw::Other;
+    case 'm':
+      return n == 6 && std::memcmp(p, "mtllib", 6) == 0 ? Kw::Mtllib : Kw::Other;
+    default:
+      return Kw::Other;
   }
 }
 
@@ -202,10 +211,12 @@ long count_corners_short(const char* p, const char* se) {
   for (int i = 0; i < 4; ++i) {
     const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16 * i));
     const __m128i b = _mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8(' ')), _mm_cmpeq_epi8(x, _mm_set1_epi8('\r')));
-    const __m128i o = _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8('\t')), _mm_cmpeq_epi8(x, _mm_set1_epi8('#'))),
-                                   _mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8('\\')), _mm_cmpeq_epi8(x, _mm_set1_epi8('\v'))));
+    const __m128i o =
+        _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8('\t')), _mm_cmpeq_epi8(x, _mm_set1_epi8('#'))),
+                     _mm_or_si128(_mm_cmpeq_epi8(x, _mm_set1_epi8('\\')), _mm_cmpeq_epi8(x, _mm_set1_epi8('\v'))));
     blank |= std::uint64_t(unsigned(_mm_movemask_epi8(b))) << (16 * i);
-    odd |= std::uint64_t(unsigned(_mm_movemask_epi8(_mm_or_si128(o, _mm_cmpeq_epi8(x, _mm_set1_epi8('\f')))))) << (16 * i);
+    odd |= std::uint64_t(unsigned(_mm_movemask_epi8(_mm_or_si128(o, _mm_cmpeq_epi8(x, _mm_set1_epi8('\f'))))))
+           << (16 * i);
   }
   const std::uint64_t in = (std::uint64_t(1) << (se - p)) - 1;
   if (odd & in) return count_corners(p, se);
@@ -232,7 +243,8 @@ void count_chunk(Chunk& c) {
         auto eq = [&](char ch) { return _mm_cmpeq_epi8(x, _mm_set1_epi8(ch)); };
         nl |= std::uint64_t(unsigned(_mm_movemask_epi8(eq('\n')))) << (16 * i);
         blank |= std::uint64_t(unsigned(_mm_movemask_epi8(_mm_or_si128(eq(' '), eq('\r'))))) << (16 * i);
-        const __m128i o = _mm_or_si128(_mm_or_si128(eq('\t'), eq('#')), _mm_or_si128(eq('\\'), _mm_or_si128(eq('\v'), eq('\f'))));
+        const __m128i o =
+            _mm_or_si128(_mm_or_si128(eq('\t'), eq('#')), _mm_or_si128(eq('\\'), _mm_or_si128(eq('\v'), eq('\f'))));
         odd |= std::uint64_t(unsigned(_mm_movemask_epi8(o))) << (16 * i);
       }
       if (nl) {
@@ -265,9 +277,15 @@ void count_chunk(Chunk& c) {
     const char* kend = nullptr;
     const char* s = p;
     switch (read_keyword(s, se, &kend)) {
-      case Kw::V: ++c.nv; break;
-      case Kw::VT: ++c.nvt; break;
-      case Kw::VN: ++c.nvn; break;
+      case Kw::V:
+        ++c.nv;
+        break;
+      case Kw::VT:
+        ++c.nvt;
+        break;
+      case Kw::VN:
+        ++c.nvn;
+        break;
       case Kw::Usemtl:
         c.has_usemtl = true;
         c.last_usemtl = std::string(rest_as_name(kend, se));
@@ -277,7 +295,8 @@ void count_chunk(Chunk& c) {
         c.ntris += n > 2 ? n - 2 : 0;
         break;
       }
-      default: break;
+      default:
+        break;
     }
     if (se < c.end) ++line;
     p = se + 1;
@@ -308,7 +327,8 @@ Hint quick_count(const char* s, size_t n) {
 #if defined(__SSE2__)
   const __m128i NL = _mm_set1_epi8('\n');
   for (; i + 16 <= m; i += 16) {
-    unsigned bits = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(u + i)), NL)));
+    unsigned bits =
+        unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(u + i)), NL)));
     for (; bits; bits &= bits - 1) line_at(i + size_t(__builtin_ctz(bits)));
   }
 #endif
@@ -364,8 +384,7 @@ void face_normals(const std::vector<Vec3d>& pos, MeshTriangle* t, size_t n) {
     const __m128d gx = _mm_sub_pd(_mm_mul_pd(uy, wz), _mm_mul_pd(uz, wy));
     const __m128d gy = _mm_sub_pd(_mm_mul_pd(uz, wx), _mm_mul_pd(ux, wz));
     const __m128d gz = _mm_sub_pd(_mm_mul_pd(ux, wy), _mm_mul_pd(uy, wx));
-    const __m128d len =
-        _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(gx, gx), _mm_mul_pd(gy, gy)), _mm_mul_pd(gz, gz)));
+    const __m128d len = _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(gx, gx), _mm_mul_pd(gy, gy)), _mm_mul_pd(gz, gz)));
     const __m128d ok = _mm_and_pd(_mm_cmpgt_pd(len, zero), _mm_cmplt_pd(len, inf));  // len > 0, finite
     const __m128d nx = _mm_and_pd(ok, _mm_div_pd(gx, len)), ny = _mm_and_pd(ok, _mm_div_pd(gy, len)),
                   nz = _mm_and_pd(ok, _mm_div_pd(gz, len));
@@ -386,9 +405,9 @@ struct ChunkParser {
   Where w;
   bool serial;
   long iv = 0, ivt = 0, ivn = 0;  // statements of each kind seen so far in the chunk
-  long itri = 0;                   // triangles written (parallel)
-  const char* here = nullptr;      // statement being parsed (serial: capacity estimates)
-  const char* stmt = "face";       // the statement whose indices are parsed, for messages
+  long itri = 0;                  // triangles written (parallel)
+  const char* here = nullptr;     // statement being parsed (serial: capacity estimates)
+  const char* stmt = "face";      // the statement whose indices are parsed, for messages
   std::vector<Corner> poly;
   std::vector<Vec3d> pts;
   std::vector<std::array<int, 3>> ears;
@@ -409,8 +428,10 @@ struct ChunkParser {
       const char* q = nullptr;
       if (end - p >= kWideReadable && p[1] == ' ' && (p[0] == 'v' || p[0] == 'f')) q = wide_line(p, end);
       if (!q && end - p > 2 && p[1] == ' ') {
-        if (p[0] == 'v') q = fast_v(p + 2, end);
-        else if (p[0] == 'f') q = fast_f(p + 2, end);
+        if (p[0] == 'v')
+          q = fast_v(p + 2, end);
+        else if (p[0] == 'f')
+          q = fast_f(p + 2, end);
       }
       if (q) {
         ++line;
@@ -451,7 +472,7 @@ struct ChunkParser {
     const std::uint64_t r1 = sp & (sp - 1), r2 = r1 & (r1 - 1);
     if (!r1 || !r2 || (r2 & (r2 - 1))) return nullptr;
     const int s1 = __builtin_ctzll(r1), s2 = __builtin_ctzll(r2);
-    const int last = p[len - 1] == '\r' ? len - 1 : len;  // end of the third token
+    const int last = p[len - 1] == '\r' ? len - 1 : len;            // end of the third token
     if (s1 == 2 || s2 == s1 + 1 || last <= s2 + 1) return nullptr;  // an empty token
     if (p[0] == 'v') {
       double x[3];
@@ -550,9 +571,7 @@ struct ChunkParser {
     while (p < end && is_blank(*p)) ++p;
     return p;
   }
-  static bool value_end(const char* p, const char* end) {
-    return p >= end || is_blank(*p) || *p == '\r' || *p == '\n';
-  }
+  static bool value_end(const char* p, const char* end) { return p >= end || is_blank(*p) || *p == '\r' || *p == '\n'; }
 
   const char* fast_v(const char* p, const char* end) {
     double x[3];
@@ -593,20 +612,47 @@ struct ChunkParser {
     const char* kend = nullptr;
     const Kw kw = read_keyword(p, se, &kend);
     switch (kw) {
-      case Kw::Empty: return;
-      case Kw::V: parse_v(kend, se, line); return;
-      case Kw::VT: parse_vt(kend, se, line); return;
-      case Kw::VN: parse_vn(kend, se, line); return;
-      case Kw::F: parse_f(kend, se, line); return;
-      case Kw::VP: ++c.vp; return;
-      case Kw::L: parse_lp(kend, se, line, "line", 2), ++c.l; return;
-      case Kw::P: parse_lp(kend, se, line, "point", 1), ++c.p; return;
-      case Kw::O: c.cur_object = parse_name(c.objects, kend, se, line), tags_changed = true; return;
-      case Kw::Usemtl: c.cur_mat = parse_name(c.mats, kend, se, line); return;
-      case Kw::G: c.cur_group = parse_group(kend, se, line), tags_changed = true; return;
-      case Kw::S: c.cur_smooth = parse_s(kend, se, line), tags_changed = true; return;
-      case Kw::Mtllib: c.mtllibs.emplace_back(line, std::string(rest_as_name(kend, se))); return;
-      default: unknown(p, kend, line); return;
+      case Kw::Empty:
+        return;
+      case Kw::V:
+        parse_v(kend, se, line);
+        return;
+      case Kw::VT:
+        parse_vt(kend, se, line);
+        return;
+      case Kw::VN:
+        parse_vn(kend, se, line);
+        return;
+      case Kw::F:
+        parse_f(kend, se, line);
+        return;
+      case Kw::VP:
+        ++c.vp;
+        return;
+      case Kw::L:
+        parse_lp(kend, se, line, "line", 2), ++c.l;
+        return;
+      case Kw::P:
+        parse_lp(kend, se, line, "point", 1), ++c.p;
+        return;
+      case Kw::O:
+        c.cur_object = parse_name(c.objects, kend, se, line), tags_changed = true;
+        return;
+      case Kw::Usemtl:
+        c.cur_mat = parse_name(c.mats, kend, se, line);
+        return;
+      case Kw::G:
+        c.cur_group = parse_group(kend, se, line), tags_changed = true;
+        return;
+      case Kw::S:
+        c.cur_smooth = parse_s(kend, se, line), tags_changed = true;
+        return;
+      case Kw::Mtllib:
+        c.mtllibs.emplace_back(line, std::string(rest_as_name(kend, se)));
+        return;
+      default:
+        unknown(p, kend, line);
+        return;
     }
   }
 
@@ -637,12 +683,12 @@ struct ChunkParser {
     // overflows the kernels' products, and a 1e80 triangle rendered as
     // ambient only, from 1e120 black, with exit 0.
     for (int k = 0; k < 3; ++k)
-      if (!(std::abs(x[k]) <= 1e30))
-      {
+      if (!(std::abs(x[k]) <= 1e30)) {
         char num[32];
         std::snprintf(num, sizeof num, "%.6g", x[k]);
-        w.fail(line, std::string("v: coordinate ") + num + " has a magnitude above 1e30 (its square would overflow "
-                     "a double's products)");
+        w.fail(line, std::string("v: coordinate ") + num +
+                         " has a magnitude above 1e30 (its square would overflow "
+                         "a double's products)");
       }
     put_position({x[0], x[1], x[2]});
   }
@@ -682,7 +728,8 @@ struct ChunkParser {
         i = -i;
       }
     }
-    if (ec == std::errc::result_out_of_range) w.fail(line, std::string(kind) + " index out of range '" + token_text(tok, se) + "'");
+    if (ec == std::errc::result_out_of_range)
+      w.fail(line, std::string(kind) + " index out of range '" + token_text(tok, se) + "'");
     if (ec != std::errc() || (p != tok && *p == '-'))
       w.fail(line, std::string("malformed ") + kind + " index '" + token_text(tok, se) + "'");
     if (i == 0) w.fail(line, std::string(kind) + " index 0 (OBJ indices start at 1)");
@@ -694,7 +741,8 @@ struct ChunkParser {
       // then passed and read before the first vertex).
       if (i < -static_cast<long long>(count))
         w.fail(line, std::string("relative ") + kind + " index " + std::to_string(i) +
-                         " reaches before the first one (" + std::to_string(count) + " defined before this " + stmt + ")");
+                         " reaches before the first one (" + std::to_string(count) + " defined before this " + stmt +
+                         ")");
       out = int(count + i);
     }
     return q;
@@ -740,7 +788,8 @@ struct ChunkParser {
       if (p >= se || *p == '#') break;
       p = parse_index(p, se, nv, "vertex", line, unused);
       if (what[0] == 'l' && p < se && *p == '/') p = parse_index(p + 1, se, nvt, "texture", line, unused);
-      if (!at_separator(p, se)) w.fail(line, "malformed " + std::string(what) + " vertex near '" + token_text(p, se) + "'");
+      if (!at_separator(p, se))
+        w.fail(line, "malformed " + std::string(what) + " vertex near '" + token_text(p, se) + "'");
       ++n;
     }
     stmt = "face";
@@ -757,8 +806,8 @@ struct ChunkParser {
       p = skip_ws(p, se);
       if (p >= se || *p == '#') break;
       if (poly.size() == size_t(kMaxPolygonCorners))
-        w.fail(line, "face of more than " + std::to_string(kMaxPolygonCorners) +
-                         " corners (the limit a polygon; split it)");
+        w.fail(line,
+               "face of more than " + std::to_string(kMaxPolygonCorners) + " corners (the limit a polygon; split it)");
       poly.push_back({-1, -1, -1});  // parsed in place (no copy of a temporary)
       Corner& k = poly.back();
       p = parse_index(p, se, nv, "vertex", line, k.v);
@@ -918,8 +967,10 @@ struct ChunkParser {
     // took over 20 s.
     std::string kw(k, size_t(kend - k));
     const auto [it, fresh] = c.unknown_at.try_emplace(kw, c.unknown.size());
-    if (fresh) c.unknown.push_back({std::move(kw), line, 1});
-    else ++c.unknown[it->second].count;
+    if (fresh)
+      c.unknown.push_back({std::move(kw), line, 1});
+    else
+      ++c.unknown[it->second].count;
   }
 };
 
@@ -1027,9 +1078,9 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
         if (!loaded.insert(key).second) continue;
         if (const std::string why = input_file_problem(file); !why.empty()) {
           missing.add(line, located(m.path, line,
-                                       "material library '" + short_quote(f) + "' " +
-                                           (why == "no such file" ? std::string("not found") : why) +
-                                           " (its materials get defaults)"));
+                                    "material library '" + short_quote(f) + "' " +
+                                        (why == "no such file" ? std::string("not found") : why) +
+                                        " (its materials get defaults)"));
           continue;
         }
         for (auto& mat : load_mtl(file, m.warnings)) {
@@ -1055,8 +1106,9 @@ void resolve_materials(Mesh& m, const NameTable& used, const std::vector<std::pa
       map[i] = it->second;
     } else {
       if (opt.load_materials)
-        undefined.add(used.lines[i], located(m.path, used.lines[i],
-                                             "material '" + short_quote(used.names[i]) + "' is not defined (default material used)"));
+        undefined.add(used.lines[i],
+                      located(m.path, used.lines[i],
+                              "material '" + short_quote(used.names[i]) + "' is not defined (default material used)"));
       MtlMaterial d;
       d.name = used.names[i];
       map[i] = int(m.materials.size());
@@ -1096,8 +1148,7 @@ void finish_chunk(Chunk& c, Mesh& m, bool first) {
       MeshTriangle& t = m.triangles[size_t(d.tri + k)];
       t.gnormal = face_normal(m.positions, t.v);
     }
-  for (auto [b, e] : c.late_normals)
-    face_normals(m.positions, m.triangles.data() + b, size_t(e - b));
+  for (auto [b, e] : c.late_normals) face_normals(m.positions, m.triangles.data() + b, size_t(e - b));
   // Every chunk started with the material in force, so only local ids that
   // differ from the global ones need rewriting.
   bool identity = true;
@@ -1146,14 +1197,15 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
     mtllibs.insert(mtllibs.end(), c.mtllibs.begin(), c.mtllibs.end());
     for (auto& u : c.unknown) {
       const auto [it, fresh] = unknown_at.try_emplace(u.keyword, unknown.size());
-      if (fresh) unknown.push_back(u);
-      else unknown[it->second].count += u.count;
+      if (fresh)
+        unknown.push_back(u);
+      else
+        unknown[it->second].count += u.count;
     }
     if (c.mixed && mixed == 0) mixed_line = c.mixed_first_line;
     mixed += c.mixed;
   }
-  if (chunks.size() > 1)
-    run_parallel(chunks, [&](Chunk& c) { finish_chunk(c, m, &c == &chunks[0]); });
+  if (chunks.size() > 1) run_parallel(chunks, [&](Chunk& c) { finish_chunk(c, m, &c == &chunks[0]); });
   long limited = 0, limited_line = 0;
   int limited_n = 0;
   for (const auto& c : chunks) {  // in file order: the warning names the first such polygon
@@ -1185,10 +1237,13 @@ void merge(Mesh& m, std::vector<Chunk>& chunks, const ObjOptions& opt) {
                                      std::to_string(mixed) + (mixed == 1 ? " face)" : " faces)")));
   if (limited)
     m.warnings.push_back(located(m.path, limited_line,
-                                 "polygon of " + std::to_string(limited_n) + " corners is too irregular for ear "
-                                 "clipping within " + std::to_string(kEarClipWorkPerCorner) +
-                                 " steps a corner: its remaining corners were cut as a fan, whose triangles may "
-                                 "overlap (" + std::to_string(limited) + (limited == 1 ? " polygon)" : " polygons)")));
+                                 "polygon of " + std::to_string(limited_n) +
+                                     " corners is too irregular for ear "
+                                     "clipping within " +
+                                     std::to_string(kEarClipWorkPerCorner) +
+                                     " steps a corner: its remaining corners were cut as a fan, whose triangles may "
+                                     "overlap (" +
+                                     std::to_string(limited) + (limited == 1 ? " polygon)" : " polygons)")));
   resolve_materials(m, mats, mtllibs, opt);
 }
 
@@ -1274,9 +1329,9 @@ std::string read_file_bytes(const std::filesystem::path& file, std::uint64_t max
   const auto size = std::filesystem::file_size(file, ec);
   if (ec) throw InputError(located(file.string(), 0, "cannot read: " + ec.message()));
   if (size > max_bytes)
-    throw InputError(located(file.string(), 0,
-                             "file is " + std::to_string(size) + " bytes, more than the limit of " +
-                                 std::to_string(max_bytes)));
+    throw InputError(
+        located(file.string(), 0,
+                "file is " + std::to_string(size) + " bytes, more than the limit of " + std::to_string(max_bytes)));
   std::ifstream f(file, std::ios::binary);
   if (!f) throw InputError(located(file.string(), 0, "cannot open"));
   // Read to the end, whatever the size said: /proc files say 0 (and were
@@ -1287,7 +1342,8 @@ std::string read_file_bytes(const std::filesystem::path& file, std::uint64_t max
   while (f.read(chunk, sizeof chunk) || f.gcount() > 0) {
     buf.append(chunk, size_t(f.gcount()));
     if (buf.size() > max_bytes)
-      throw InputError(located(file.string(), 0, "file is more than the limit of " + std::to_string(max_bytes) + " bytes"));
+      throw InputError(
+          located(file.string(), 0, "file is more than the limit of " + std::to_string(max_bytes) + " bytes"));
   }
   if (f.bad()) throw InputError(located(file.string(), 0, "read failed: " + std::string(std::strerror(errno))));
   return buf;

@@ -46,8 +46,10 @@ void expect_geometry_impl(const Mesh& m, const Geometry& g) {
   EXPECT_EQ(m.uvs.size(), g.uvs) << "uvs";
   EXPECT_EQ(m.normals.size(), g.normals) << "normals";
   EXPECT_EQ(m.triangles.size(), g.triangles) << "triangles";
-  if (g.tol == 0) EXPECT_DOUBLE_EQ(m.area(), g.area) << "area";
-  else EXPECT_NEAR(m.area(), g.area, g.tol) << "area";
+  if (g.tol == 0)
+    EXPECT_DOUBLE_EQ(m.area(), g.area) << "area";
+  else
+    EXPECT_NEAR(m.area(), g.area, g.tol) << "area";
   const Bounds3d b = m.bbox();
   for (int k = 0; k < 3; ++k) {
     if (g.tol == 0) {
@@ -60,9 +62,9 @@ void expect_geometry_impl(const Mesh& m, const Geometry& g) {
   }
 }
 // The failure points at the caller's line.
-#define EXPECT_GEOMETRY(m, ...)             \
-  do {                                      \
-    SCOPED_TRACE("EXPECT_GEOMETRY");        \
+#define EXPECT_GEOMETRY(m, ...)                    \
+  do {                                             \
+    SCOPED_TRACE("EXPECT_GEOMETRY");               \
     expect_geometry_impl(m, Geometry __VA_ARGS__); \
   } while (0)
 // kTri with one triangle: 3 v, area 0.5, box (0,0,0)..(1,1,0).
@@ -188,8 +190,8 @@ TEST(ObjFaces, VeryLongLineFaceOf1000Vertices) {
   }
   TempDir d;
   const Mesh m = load_text(d, s + "\n");
-  EXPECT_GEOMETRY(m, {size_t(n), 0, 0, size_t(n - 2), 500 * std::sin(std::numbers::pi / 500), {-1, -1, 0}, {1, 1, 0},
-                      1e-12});
+  EXPECT_GEOMETRY(
+      m, {size_t(n), 0, 0, size_t(n - 2), 500 * std::sin(std::numbers::pi / 500), {-1, -1, 0}, {1, 1, 0}, 1e-12});
 }
 
 // CORPUS.md Faces: mixed forms within one face (accepted, with a warning).
@@ -199,8 +201,9 @@ TEST(ObjFaces, MixedFormsDropTheComponentNotOnEveryCorner) {
   ASSERT_EQ(m.triangles.size(), 1u);
   EXPECT_EQ(m.triangles[0].t[0], -1);  // corner 2 has no vt
   EXPECT_EQ(m.triangles[0].n[1], 0);   // every corner has vn
-  EXPECT_TRUE(has_warning(m, "t.obj:6: face mixes vertex forms (v, v/vt, v//vn, v/vt/vn); texture or normal "
-                             "indices not on every corner were dropped (1 face)"));
+  EXPECT_TRUE(has_warning(m,
+                          "t.obj:6: face mixes vertex forms (v, v/vt, v//vn, v/vt/vn); texture or normal "
+                          "indices not on every corner were dropped (1 face)"));
   EXPECT_GEOMETRY(m, {3, 1, 1, 1, 0.5, {0, 0, 0}, {1, 1, 0}});
 }
 
@@ -247,7 +250,8 @@ TEST(ObjText, CrlfLineEnds) {
   EXPECT_KTRI(m, 1);
   ASSERT_EQ(m.materials.size(), 1u);
   EXPECT_EQ(m.materials[0].name, "red");  // no '\r' in the name
-  EXPECT_EQ(load_error("v 0 0 0\r\nv 1 0 0\r\nf 1 2 3\r\n"), "t.obj:3: vertex index 3 is past the end: the file has only 2 vertices");
+  EXPECT_EQ(load_error("v 0 0 0\r\nv 1 0 0\r\nf 1 2 3\r\n"),
+            "t.obj:3: vertex index 3 is past the end: the file has only 2 vertices");
 }
 
 // Not in CORPUS.md, found with it: CR-only line ends (classic Mac OS) are
@@ -357,15 +361,24 @@ TEST(ObjNumbers, FastPathsMatchFromCharsExactly) {
     const double mag = std::pow(10.0, double(int(rnd() % 40)) - 20.0);
     const double x = (double(rnd() % 2000001) / 1e6 - 1.0) * mag;
     switch (rnd() % 4) {
-      case 0: std::snprintf(buf, sizeof buf, "%.*f", int(rnd() % 12), x); break;
-      case 1: std::snprintf(buf, sizeof buf, "%.*e", int(rnd() % 18), x); break;
-      case 2: std::snprintf(buf, sizeof buf, "%.*g", int(1 + rnd() % 17), x); break;
-      default: std::snprintf(buf, sizeof buf, "%lld.%0*llu", (long long)(rnd() % 100000000) - 50000000,
-                             int(rnd() % 10), (unsigned long long)(rnd() % 10000000000ull)); break;
+      case 0:
+        std::snprintf(buf, sizeof buf, "%.*f", int(rnd() % 12), x);
+        break;
+      case 1:
+        std::snprintf(buf, sizeof buf, "%.*e", int(rnd() % 18), x);
+        break;
+      case 2:
+        std::snprintf(buf, sizeof buf, "%.*g", int(1 + rnd() % 17), x);
+        break;
+      default:
+        std::snprintf(buf, sizeof buf, "%lld.%0*llu", (long long)(rnd() % 100000000) - 50000000, int(rnd() % 10),
+                      (unsigned long long)(rnd() % 10000000000ull));
+        break;
     }
     tokens.push_back(buf);
   }
-  for (size_t i = 0; i + 3 <= tokens.size(); i += 3) text += "v " + tokens[i] + " " + tokens[i + 1] + " " + tokens[i + 2] + "\n";
+  for (size_t i = 0; i + 3 <= tokens.size(); i += 3)
+    text += "v " + tokens[i] + " " + tokens[i + 1] + " " + tokens[i + 2] + "\n";
   const Mesh m = parse_obj(text, "n.obj");
   ASSERT_EQ(m.positions.size(), tokens.size() / 3);
   for (size_t i = 0; i + 3 <= tokens.size(); ++i) {
@@ -400,7 +413,7 @@ TEST(ObjNumbers, AbsurdlyLongNumberIsAnError) {
   const std::string digits(10000, '1');
   EXPECT_EQ(load_error("v 0 0 " + digits + "\n"), "t.obj:1: number too long (10000 characters, at most 200)");
   EXPECT_EQ(load_error("v 0 0 1e-400\n"), "t.obj:1: number out of range '1e-400'");  // underflow too
-  const std::string zeros = "0." + std::string(10000, '0') + "1";  // in range, but 10003 characters
+  const std::string zeros = "0." + std::string(10000, '0') + "1";                    // in range, but 10003 characters
   EXPECT_EQ(load_error("v 0 0 " + zeros + "\n"), "t.obj:1: number too long (10003 characters, at most 200)");
 }
 
@@ -455,11 +468,11 @@ TEST(ObjGrouping, ObjectsGroupsSmoothingAndMaterials) {
   d.write("a.mtl", "newmtl red\nKd 1 0 0\n");
   d.write("b.mtl", "newmtl blue\nKd 0 0 1\n");
   const Mesh m = load_text(d, std::string(kTri) +
-                                  "f 1 2 3\n"              // before anything: -1 everywhere
+                                  "f 1 2 3\n"               // before anything: -1 everywhere
                                   "mtllib a.mtl   b.mtl\n"  // two libraries
                                   "usemtl blue\n"           // usemtl before o
                                   "o first thing\n"
-                                  "g left  right\n"         // two names: one group "left right"
+                                  "g left  right\n"  // two names: one group "left right"
                                   "s 1\n"
                                   "f 1 2 3\n"
                                   "g other\nusemtl red\ns off\n"
@@ -560,7 +573,8 @@ TEST(ObjErrors, IndexErrorsNameTheFaceLine) {
             "t.obj:4: relative vertex index -4 reaches before the first one (3 defined before this face)");
   EXPECT_EQ(load_error(t + "vt 0 0\nf 1/2 2/1 3/1\n"),
             "t.obj:5: texture index 2 is past the end: the file has only 1 texture coordinate");
-  EXPECT_EQ(load_error(t + "f 1//1 2//1 3//1\n"), "t.obj:4: normal index 1 is past the end: the file has only 0 normals");
+  EXPECT_EQ(load_error(t + "f 1//1 2//1 3//1\n"),
+            "t.obj:4: normal index 1 is past the end: the file has only 0 normals");
   EXPECT_EQ(load_error(t + "f 1 2\n"), "t.obj:4: face with 2 vertices (at least 3 needed)");
   EXPECT_EQ(load_error(t + "f\n"), "t.obj:4: face with 0 vertices (at least 3 needed)");
   EXPECT_EQ(load_error(t + "f 1 2 3x\n"), "t.obj:4: malformed face vertex near 'x'");
@@ -577,8 +591,8 @@ TEST(ObjErrors, ForwardReferenceAndNeverDefinedAreTold) {
   const std::string t = kTri;
   auto forward = [](int face_line, const char* kind, int index, int defined_line, int before) {
     return "t.obj:" + std::to_string(face_line) + ": " + kind + " index " + std::to_string(index) +
-           " is defined later, at line " + std::to_string(defined_line) +
-           ": forward references are not allowed (" + std::to_string(before) + " defined before this face)";
+           " is defined later, at line " + std::to_string(defined_line) + ": forward references are not allowed (" +
+           std::to_string(before) + " defined before this face)";
   };
   // vertex 4 is the `v` on line 6 (line 5 is a vt, which does not count).
   EXPECT_EQ(load_error(t + "f 1 2 4\nvt 0 0\nv 1 1 1\n"), forward(4, "vertex", 4, 6, 3));
@@ -588,7 +602,8 @@ TEST(ObjErrors, ForwardReferenceAndNeverDefinedAreTold) {
   EXPECT_EQ(load_error(t + "f 1/1 2/1 3/2\nvt 0 0\nvt 1 1\n"), forward(4, "texture", 1, 5, 0));
   EXPECT_EQ(load_error(t + "vn 0 0 1\nf 1//1 2//1 3//2\nvn 0 0 1\n"), forward(5, "normal", 2, 6, 1));
   // Never defined: the count is the whole file's (4 v, one after the face).
-  EXPECT_EQ(load_error(t + "f 1 2 9\nv 1 1 1\n"), "t.obj:4: vertex index 9 is past the end: the file has only 4 vertices");
+  EXPECT_EQ(load_error(t + "f 1 2 9\nv 1 1 1\n"),
+            "t.obj:4: vertex index 9 is past the end: the file has only 4 vertices");
   EXPECT_EQ(load_error("v 0 0 0\nf 1 1 2\n"), "t.obj:2: vertex index 2 is past the end: the file has only 1 vertex");
 }
 

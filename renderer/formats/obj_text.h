@@ -28,8 +28,10 @@ struct CappedWarnings {
   std::string rest;  // "more material libraries not found"
   long n = 0, first_line = 0;
   void add(long line, std::string message) {
-    if (++n <= kShown) out.push_back(std::move(message));
-    else if (n == kShown + 1) first_line = line;
+    if (++n <= kShown)
+      out.push_back(std::move(message));
+    else if (n == kShown + 1)
+      first_line = line;
   }
   void finish() {
     if (n > kShown) out.push_back(located(file, first_line, std::to_string(n - kShown) + " " + rest));
@@ -210,10 +212,14 @@ inline bool fast_double(const char*& p, const char* end, double& out) {
     e10 += eneg ? -e : e;
   }
   double v;
-  if (mant == 0) v = 0;
-  else if (e10 < 0 && e10 >= -22) v = double(mant) / kPow10[-e10];
-  else if (e10 >= 0 && e10 <= 22) v = double(mant) * kPow10[e10];
-  else return false;
+  if (mant == 0)
+    v = 0;
+  else if (e10 < 0 && e10 >= -22)
+    v = double(mant) / kPow10[-e10];
+  else if (e10 >= 0 && e10 <= 22)
+    v = double(mant) * kPow10[e10];
+  else
+    return false;
   out = neg ? -v : v;
   p = s;
   return true;
@@ -238,15 +244,14 @@ inline const char* parse_double(const char* p, const char* end, double& out, con
   if (q - tok > kMaxNumberChars && ec != std::errc::invalid_argument)
     w.fail(line, "number too long (" + std::to_string(q - tok) + " characters, at most " +
                      std::to_string(kMaxNumberChars) + ")");
-  if (ec == std::errc::result_out_of_range)
-    w.fail(line, "number out of range '" + token_text(tok, end) + "'");
+  if (ec == std::errc::result_out_of_range) w.fail(line, "number out of range '" + token_text(tok, end) + "'");
   if (ec != std::errc()) {
     if (tok >= end || *tok == '#' || *tok == '\n') w.fail(line, "expected a number, found the end of the line");
     w.fail(line, "malformed number '" + token_text(tok, end) + "'");
   }
   if (q < end && *q == '#' &&
-      (starts_with_ci(q + 1, end, "IND") || starts_with_ci(q + 1, end, "INF") ||
-       starts_with_ci(q + 1, end, "QNAN") || starts_with_ci(q + 1, end, "SNAN")))
+      (starts_with_ci(q + 1, end, "IND") || starts_with_ci(q + 1, end, "INF") || starts_with_ci(q + 1, end, "QNAN") ||
+       starts_with_ci(q + 1, end, "SNAN")))
     w.fail(line, "non-finite number '" + token_text(tok, end) + "' (MSVC notation) is not accepted");
   if (!at_separator(q, end)) w.fail(line, "malformed number '" + token_text(tok, end) + "'");
   if (!std::isfinite(out)) w.fail(line, "non-finite number '" + token_text(tok, end) + "' is not accepted");
@@ -303,8 +308,9 @@ inline std::string_view check_encoding(std::string_view text, const std::string&
     for (const char* c = b; (c = static_cast<const char*>(std::memchr(c, '\r', size_t(lim - c)))) != nullptr;) {
       ++c;
       if (c < lim && !is_space(*c))
-        throw InputError(located(name, 1, "the file uses CR-only line ends (classic Mac OS), which are not "
-                                          "supported: convert them to LF or CRLF"));
+        throw InputError(located(name, 1,
+                                 "the file uses CR-only line ends (classic Mac OS), which are not "
+                                 "supported: convert them to LF or CRLF"));
     }
   }
   if (const void* z = std::memchr(text.data(), 0, text.size())) {

@@ -127,8 +127,7 @@ TEST(ObjVsTinyobj, TrianglesByHandCountsPolygons) {
 
 TEST(ObjVsTinyobj, EveryCorpusFile) {
   const auto files = corpus_objs();
-  if (files.size() < 10)
-    GTEST_SKIP() << "corpus missing under " << corpus_root() << ": run ci/fetch-corpus.sh first";
+  if (files.size() < 10) GTEST_SKIP() << "corpus missing under " << corpus_root() << ": run ci/fetch-corpus.sh first";
   int compared = 0;
   std::set<std::string> seen;
   for (const auto& f : files) {
@@ -148,8 +147,10 @@ TEST(ObjVsTinyobj, EveryCorpusFile) {
     } catch (const InputError& e) {
       our_err = e.what();
     }
-    if (kTinyRejects.count(key)) EXPECT_FALSE(tiny_ok) << "listed as rejected by tinyobj: " << kTinyRejects.at(key);
-    else EXPECT_TRUE(tiny_ok) << "tinyobj rejects it and kTinyRejects does not say why: " << err;
+    if (kTinyRejects.count(key))
+      EXPECT_FALSE(tiny_ok) << "listed as rejected by tinyobj: " << kTinyRejects.at(key);
+    else
+      EXPECT_TRUE(tiny_ok) << "tinyobj rejects it and kTinyRejects does not say why: " << err;
     if (kWeReject.count(key)) {
       EXPECT_EQ(our_err, f.string() + kWeReject.at(key));
       continue;
@@ -236,7 +237,9 @@ TEST(ObjVsTinyobj, OffConvertedByUsMatchesTheOffFile) {
     EXPECT_EQ(m.triangles.size(), tris);
     ++checked;
   }
-  if (checked == 0) GTEST_SKIP() << "no OFF meshes under " << root / "off" << ": run ci/fetch-corpus.sh first";
+  if (checked == 0)
+    GTEST_SKIP() << "no OFF meshes under " << root / "off"
+                 << ": run ci/fetch-corpus.sh first";
   EXPECT_EQ(checked, 3);
 }
 
@@ -249,8 +252,7 @@ namespace {
 // The parallel parse on real files: identical triangles to the serial one.
 TEST(ObjParallelCorpus, SameAsSerial) {
   const auto files = corpus_objs();
-  if (files.size() < 10)
-    GTEST_SKIP() << "corpus missing under " << corpus_root() << ": run ci/fetch-corpus.sh first";
+  if (files.size() < 10) GTEST_SKIP() << "corpus missing under " << corpus_root() << ": run ci/fetch-corpus.sh first";
   ObjOptions par;
   par.threads = 3;
   par.parallel_min_bytes = 0;

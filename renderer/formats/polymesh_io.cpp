@@ -68,8 +68,7 @@ struct Tokens {
     const char* b = p;
     if (p < e && *p == '+') ++p;
     auto [q, ec] = std::from_chars(p, e, v);
-    if (ec != std::errc() || (q < e && *q != ' ' && *q != '\t' && *q != '\r' && *q != '\n'))
-    {
+    if (ec != std::errc() || (q < e && *q != ' ' && *q != '\t' && *q != '\r' && *q != '\n')) {
       const char* te = b;
       while (te < e && te - b < 20 && *te != ' ' && *te != '\t' && *te != '\r' && *te != '\n') ++te;
       fail(std::string("malformed ") + what + " '" + std::string(b, te) + "'");
@@ -84,9 +83,10 @@ void check_faces(PolyMesh& m, const std::string& name) {
   for (size_t f = 0; f + 1 < m.face_start.size(); ++f)
     for (int i = m.face_start[f]; i < m.face_start[f + 1]; ++i)
       if (m.indices[size_t(i)] < 0 || m.indices[size_t(i)] >= n)
-        throw InputError(located(name, 0, "face " + std::to_string(f) + " has vertex index " +
-                                              std::to_string(m.indices[size_t(i)]) + " out of range (" +
-                                              std::to_string(n) + " vertices)"));
+        throw InputError(located(name, 0,
+                                 "face " + std::to_string(f) + " has vertex index " +
+                                     std::to_string(m.indices[size_t(i)]) + " out of range (" + std::to_string(n) +
+                                     " vertices)"));
 }
 
 enum class PlyType { I8, U8, I16, U16, I32, U32, F32, F64 };
@@ -106,10 +106,10 @@ struct PlyElement {
 
 bool ply_type(std::string_view s, PlyType& t) {
   static const std::pair<const char*, PlyType> names[] = {
-      {"char", PlyType::I8},    {"int8", PlyType::I8},     {"uchar", PlyType::U8},   {"uint8", PlyType::U8},
-      {"short", PlyType::I16},  {"int16", PlyType::I16},   {"ushort", PlyType::U16}, {"uint16", PlyType::U16},
-      {"int", PlyType::I32},    {"int32", PlyType::I32},   {"uint", PlyType::U32},   {"uint32", PlyType::U32},
-      {"float", PlyType::F32},  {"float32", PlyType::F32}, {"double", PlyType::F64}, {"float64", PlyType::F64}};
+      {"char", PlyType::I8},   {"int8", PlyType::I8},     {"uchar", PlyType::U8},   {"uint8", PlyType::U8},
+      {"short", PlyType::I16}, {"int16", PlyType::I16},   {"ushort", PlyType::U16}, {"uint16", PlyType::U16},
+      {"int", PlyType::I32},   {"int32", PlyType::I32},   {"uint", PlyType::U32},   {"uint32", PlyType::U32},
+      {"float", PlyType::F32}, {"float32", PlyType::F32}, {"double", PlyType::F64}, {"float64", PlyType::F64}};
   for (auto& [n, v] : names)
     if (s == n) return t = v, true;
   return false;
@@ -118,23 +118,40 @@ bool ply_type(std::string_view s, PlyType& t) {
 // 300): false for a value outside it, or a fraction in an integer type.
 bool fits_ply_type(PlyType t, double v) {
   switch (t) {
-    case PlyType::I8: return v >= -128 && v <= 127 && v == std::floor(v);
-    case PlyType::U8: return v >= 0 && v <= 255 && v == std::floor(v);
-    case PlyType::I16: return v >= -32768 && v <= 32767 && v == std::floor(v);
-    case PlyType::U16: return v >= 0 && v <= 65535 && v == std::floor(v);
-    case PlyType::I32: return v >= -2147483648.0 && v <= 2147483647.0 && v == std::floor(v);
-    case PlyType::U32: return v >= 0 && v <= 4294967295.0 && v == std::floor(v);
-    case PlyType::F32: return !std::isfinite(v) || std::fabs(v) <= 3.4028234663852886e38;  // 1e39 is no float (non-finite: said by the caller)
-    default: return true;  // double: any number the reader accepted
+    case PlyType::I8:
+      return v >= -128 && v <= 127 && v == std::floor(v);
+    case PlyType::U8:
+      return v >= 0 && v <= 255 && v == std::floor(v);
+    case PlyType::I16:
+      return v >= -32768 && v <= 32767 && v == std::floor(v);
+    case PlyType::U16:
+      return v >= 0 && v <= 65535 && v == std::floor(v);
+    case PlyType::I32:
+      return v >= -2147483648.0 && v <= 2147483647.0 && v == std::floor(v);
+    case PlyType::U32:
+      return v >= 0 && v <= 4294967295.0 && v == std::floor(v);
+    case PlyType::F32:
+      return !std::isfinite(v) ||
+             std::fabs(v) <= 3.4028234663852886e38;  // 1e39 is no float (non-finite: said by the caller)
+    default:
+      return true;  // double: any number the reader accepted
   }
 }
 
 int ply_size(PlyType t) {
   switch (t) {
-    case PlyType::I8: case PlyType::U8: return 1;
-    case PlyType::I16: case PlyType::U16: return 2;
-    case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
-    default: return 8;
+    case PlyType::I8:
+    case PlyType::U8:
+      return 1;
+    case PlyType::I16:
+    case PlyType::U16:
+      return 2;
+    case PlyType::I32:
+    case PlyType::U32:
+    case PlyType::F32:
+      return 4;
+    default:
+      return 8;
   }
 }
 
@@ -147,21 +164,49 @@ struct BinReader {
   const std::string& name;
   double get(PlyType t) {
     const int n = ply_size(t);
-    if (e - p < n)
-      throw InputError(located(name, 0, "byte " + std::to_string(p - b) + ": file ends inside the data"));
+    if (e - p < n) throw InputError(located(name, 0, "byte " + std::to_string(p - b) + ": file ends inside the data"));
     unsigned char buf[8];
     std::memcpy(buf, p, size_t(n));
     if (big) std::reverse(buf, buf + n);
     p += n;
     switch (t) {
-      case PlyType::I8: { int8_t v; std::memcpy(&v, buf, 1); return v; }
-      case PlyType::U8: return buf[0];
-      case PlyType::I16: { int16_t v; std::memcpy(&v, buf, 2); return v; }
-      case PlyType::U16: { uint16_t v; std::memcpy(&v, buf, 2); return v; }
-      case PlyType::I32: { int32_t v; std::memcpy(&v, buf, 4); return v; }
-      case PlyType::U32: { uint32_t v; std::memcpy(&v, buf, 4); return v; }
-      case PlyType::F32: { float v; std::memcpy(&v, buf, 4); return v; }
-      default: { double v; std::memcpy(&v, buf, 8); return v; }
+      case PlyType::I8: {
+        int8_t v;
+        std::memcpy(&v, buf, 1);
+        return v;
+      }
+      case PlyType::U8:
+        return buf[0];
+      case PlyType::I16: {
+        int16_t v;
+        std::memcpy(&v, buf, 2);
+        return v;
+      }
+      case PlyType::U16: {
+        uint16_t v;
+        std::memcpy(&v, buf, 2);
+        return v;
+      }
+      case PlyType::I32: {
+        int32_t v;
+        std::memcpy(&v, buf, 4);
+        return v;
+      }
+      case PlyType::U32: {
+        uint32_t v;
+        std::memcpy(&v, buf, 4);
+        return v;
+      }
+      case PlyType::F32: {
+        float v;
+        std::memcpy(&v, buf, 4);
+        return v;
+      }
+      default: {
+        double v;
+        std::memcpy(&v, buf, 8);
+        return v;
+      }
     }
   }
 };
@@ -201,12 +246,13 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
   if (t.word() != "ply") t.fail("not a PLY file (no 'ply' magic)");
   std::vector<PlyElement> elements;
   std::unordered_set<std::string> prop_names;  // the current element's
-  int format = -1;  // 0 ascii, 1 little, 2 big
+  int format = -1;                             // 0 ascii, 1 little, 2 big
   for (;;) {
     if (t.p >= t.e) t.fail("no end_header");
     const std::string_view k = t.word();
     if (k == "format") {
-      if (format >= 0 || !elements.empty()) t.fail(format >= 0 ? "a second format line" : "format line after an element");
+      if (format >= 0 || !elements.empty())
+        t.fail(format >= 0 ? "a second format line" : "format line after an element");
       const auto f = t.word();
       format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
       if (format < 0) t.fail("unknown PLY format '" + std::string(f) + "'");
@@ -225,7 +271,8 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       if (el.count < 0 || el.count > (1L << 31)) t.fail("element count out of range");
       if (!t.at_eol()) t.fail("unexpected '" + std::string(t.word().substr(0, 40)) + "' after the element count");
       for (const auto& other : elements)  // was read as two elements, the rows concatenated
-        if (other.name == el.name) t.fail("element '" + el.name + "' given twice (first at line " + std::to_string(other.line) + ")");
+        if (other.name == el.name)
+          t.fail("element '" + el.name + "' given twice (first at line " + std::to_string(other.line) + ")");
       elements.push_back(std::move(el));
       prop_names.clear();
       t.next_line();
@@ -283,7 +330,8 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
       throw InputError(located(name, el.line, "vertex element without x, y, z"));
     for (int c : {ix, iy, iz})  // a list named x read its count as the coordinate
       if (is_vertex && el.props[size_t(c)].list)
-        throw InputError(located(name, el.props[size_t(c)].line, "vertex property '" + el.props[size_t(c)].name + "' is a list"));
+        throw InputError(
+            located(name, el.props[size_t(c)].line, "vertex property '" + el.props[size_t(c)].name + "' is a list"));
     if (is_face && ilist < 0)
       throw InputError(located(name, el.line, "face element without a vertex_indices (or vertex_index) list property"));
     // Reserve no more than the data can hold (a count alone is not trusted).
@@ -315,7 +363,8 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
                 fail("face " + std::to_string(r) + " has vertex index " + number_text(v) + ", not an integer");
               if (!(v >= 0 && v < double(m.positions.size() + (vertices_read ? 0 : 2147483647.0))))
                 fail("face " + std::to_string(r) + " has vertex index " + number_text(v) + " out of range (" +
-                     (vertices_read ? std::to_string(m.positions.size()) + " vertices, from 0)" : "not a vertex index)"));
+                     (vertices_read ? std::to_string(m.positions.size()) + " vertices, from 0)"
+                                    : "not a vertex index)"));
               m.indices.push_back(int(v));
             }
           }
@@ -352,11 +401,13 @@ PolyMesh parse_ply(std::string_view bytes, const std::string& name) {
   }
   // Data after the declared rows was ignored (a count too low, or garbage).
   if (format == 0) {
-    if (!t.at_end()) t.fail("data after the " + std::to_string(elements.empty() ? 0 : elements.back().count) +
-                            " rows the header declares for the last element");
+    if (!t.at_end())
+      t.fail("data after the " + std::to_string(elements.empty() ? 0 : elements.back().count) +
+             " rows the header declares for the last element");
   } else if (br.p != br.e) {
-    throw InputError(located(name, 0, "byte " + std::to_string(br.p - br.b) + ": " + std::to_string(br.e - br.p) +
-                                          " bytes after the data the header declares"));
+    throw InputError(located(name, 0,
+                             "byte " + std::to_string(br.p - br.b) + ": " + std::to_string(br.e - br.p) +
+                                 " bytes after the data the header declares"));
   }
   check_faces(m, name);
   return m;
@@ -392,7 +443,9 @@ static OffExtras off_extras(std::string_view m) {
 // are ignored as before (some files carry unannounced colours).
 static void check_off_extras(Tokens& t, const OffExtras& x, std::string_view magic) {
   if (!x.normal && !x.colour && !x.st) {  // "0 0 0 9 9" was read as 0 0 0
-    if (!t.at_eol()) t.fail("unexpected '" + std::string(t.word().substr(0, 40)) + "' after x y z (a COFF, NOFF or STOFF magic announces more values)");
+    if (!t.at_eol())
+      t.fail("unexpected '" + std::string(t.word().substr(0, 40)) +
+             "' after x y z (a COFF, NOFF or STOFF magic announces more values)");
     return;
   }
   int n = 0;
@@ -407,14 +460,15 @@ static void check_off_extras(Tokens& t, const OffExtras& x, std::string_view mag
   if (x.normal) add("a normal (3 values)");
   if (x.colour) add("a colour (3 or 4 values)");
   if (x.st) add("a texture coordinate (2 values)");
-  t.fail(std::string(magic) + " vertex needs x y z and " + want + " (" + std::to_string(n) +
-         " values after x y z)");
+  t.fail(std::string(magic) + " vertex needs x y z and " + want + " (" + std::to_string(n) + " values after x y z)");
 }
 
 PolyMesh parse_off(std::string_view text, const std::string& name) {
   Tokens t{text.data(), text.data() + text.size(), name};
   const std::string_view magic = t.word();
-  if (!off_magic(magic)) t.fail("not an OFF file (header '" + std::string(magic.substr(0, 20)) + "', expected OFF, COFF, NOFF, CNOFF, STOFF ...)");
+  if (!off_magic(magic))
+    t.fail("not an OFF file (header '" + std::string(magic.substr(0, 20)) +
+           "', expected OFF, COFF, NOFF, CNOFF, STOFF ...)");
   {  // "OFF BINARY" was "malformed vertex count 'BINARY'"
     const char* q = t.p;
     while (q < t.e && (*q == ' ' || *q == '\t')) ++q;
@@ -440,7 +494,8 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
   for (long i = 0; i < nv; ++i) {
     // Fewer rows than the counts: said at the line where the file ends, not
     // as "malformed face size ''" past it.
-    if (t.at_end()) t.fail("file ends after " + std::to_string(i) + " of the " + std::to_string(nv) + " vertices the counts declare");
+    if (t.at_end())
+      t.fail("file ends after " + std::to_string(i) + " of the " + std::to_string(nv) + " vertices the counts declare");
     Vec3d p;
     p.x = t.number_on_line<double>("x coordinate");
     p.y = t.number_on_line<double>("y coordinate");
@@ -454,7 +509,8 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
   }
   m.face_start.push_back(0);
   for (long f = 0; f < nf; ++f) {
-    if (t.at_end()) t.fail("file ends after " + std::to_string(f) + " of the " + std::to_string(nf) + " faces the counts declare");
+    if (t.at_end())
+      t.fail("file ends after " + std::to_string(f) + " of the " + std::to_string(nf) + " faces the counts declare");
     const long n = t.number<long>("face size");
     if (n < 3 || n > 1000000) t.fail("face with " + std::to_string(n) + " vertices");
     for (long j = 0; j < n; ++j) {
@@ -466,7 +522,8 @@ PolyMesh parse_off(std::string_view text, const std::string& name) {
     // A colour may follow (a colour-map index, RGB or RGBA): numbers only.
     int extra = 0;
     while (!t.at_eol()) t.number<double>("face colour value"), ++extra;
-    if (extra == 2 || extra > 4) t.fail("face line has " + std::to_string(extra) + " values after its indices (a colour is 1, 3 or 4)");
+    if (extra == 2 || extra > 4)
+      t.fail("face line has " + std::to_string(extra) + " values after its indices (a colour is 1, 3 or 4)");
     m.face_start.push_back(int(m.indices.size()));
     t.next_line();
   }

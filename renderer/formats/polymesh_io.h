@@ -20,8 +20,8 @@ namespace ra {
 
 struct PolyMesh {
   std::vector<Vec3d> positions;
-  std::vector<int> face_start;    // face i is indices[face_start[i] .. face_start[i+1])
-  std::vector<int> indices;       // 0-based
+  std::vector<int> face_start;  // face i is indices[face_start[i] .. face_start[i+1])
+  std::vector<int> indices;     // 0-based
   std::size_t faces() const { return face_start.empty() ? 0 : face_start.size() - 1; }
 };
 

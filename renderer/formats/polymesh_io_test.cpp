@@ -57,13 +57,15 @@ std::string binary_body(bool big) {
 }
 
 TEST(Ply, BinaryLittleAndBigEndian) {
-  expect_square(parse_ply(std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + binary_body(false), "l.ply"));
+  expect_square(
+      parse_ply(std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + binary_body(false), "l.ply"));
   expect_square(parse_ply(std::string("ply\nformat binary_big_endian 1.0\n") + kHeader + binary_body(true), "b.ply"));
 }
 
 TEST(Ply, Errors) {
   EXPECT_THROW(parse_ply("plx\n", "x.ply"), InputError);
-  const std::string trunc = std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + binary_body(false).substr(0, 30);
+  const std::string trunc =
+      std::string("ply\nformat binary_little_endian 1.0\n") + kHeader + binary_body(false).substr(0, 30);
   try {
     parse_ply(trunc, "t.ply");
     FAIL();
@@ -71,7 +73,8 @@ TEST(Ply, Errors) {
     EXPECT_NE(std::string(e.what()).find("t.ply: byte"), std::string::npos) << e.what();
   }
   try {
-    parse_ply(std::string("ply\nformat ascii 1.0\n") + kHeader + "0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n0 0 1 1\n4 0 1 2 9\n3 0 1 4\n",
+    parse_ply(std::string("ply\nformat ascii 1.0\n") + kHeader +
+                  "0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n0 0 1 1\n4 0 1 2 9\n3 0 1 4\n",
               "r.ply");
     FAIL();
   } catch (const InputError& e) {
@@ -90,14 +93,15 @@ TEST(Ply, Errors) {
     // Offsets count from the start of the file, and the quad ends where the
     // triangle's 13 bytes begin.
     EXPECT_NE(std::string(e.what()).find("b.ply: byte " + std::to_string(head.size() + body.size() - 13) + ": face 0"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("face 0 has vertex index 9 out of range"), std::string::npos) << e.what();
   }
 }
 
 TEST(Off, ReadsWithCommentsAndColours) {
-  expect_square(parse_off("OFF\n# a comment\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3 255 0 0\n3 0 1 4\n",
-                          "s.off"));
+  expect_square(
+      parse_off("OFF\n# a comment\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3 255 0 0\n3 0 1 4\n", "s.off"));
   expect_square(parse_off("OFF 5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3\n3 0 1 4\n", "s.off"));
 }
 
@@ -107,7 +111,8 @@ TEST(Off, ExtrasTheMagicPromisesAndCrOnlyLineEnds) {
   const std::string v = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n";
   auto with = [&](const std::string& extra) {
     std::string out;
-    for (std::size_t b = 0, e; (e = v.find('\n', b)) != std::string::npos; b = e + 1) out += v.substr(b, e - b) + extra + "\n";
+    for (std::size_t b = 0, e; (e = v.find('\n', b)) != std::string::npos; b = e + 1)
+      out += v.substr(b, e - b) + extra + "\n";
     return out;
   };
   const std::string faces = "4 0 1 2 3\n3 0 1 4\n";
@@ -122,7 +127,8 @@ TEST(Off, ExtrasTheMagicPromisesAndCrOnlyLineEnds) {
     parse_off("STOFF\n5 2 0\n" + with(" 0.5") + faces, "st.off");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "st.off:3: STOFF vertex needs x y z and a texture coordinate (2 values) (1 values after x y z)");
+    EXPECT_STREQ(e.what(),
+                 "st.off:3: STOFF vertex needs x y z and a texture coordinate (2 values) (1 values after x y z)");
   }
 }
 

@@ -21,8 +21,7 @@ bool in_triangle(const P2& p, const P2& a, const P2& b, const P2& c) {
 
 }  // namespace
 
-bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out,
-                         EarClipScratch& s) {
+bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out, EarClipScratch& s) {
   if (n < 3) return false;
   if (n == 3) {
     out.push_back({0, 1, 2});
@@ -88,13 +87,15 @@ bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>
     return !(c > 0) ? 0 : (c >= g - 1 ? g - 1 : int(c));  // NaN (inf - inf) too: cell 0
   };
   s.cell_start.assign(size_t(g) * size_t(g) + 1, 0);
-  for (int w : s.reflex) ++s.cell_start[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx)) + 1];
+  for (int w : s.reflex)
+    ++s.cell_start[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx)) + 1];
   for (size_t k = 1; k < s.cell_start.size(); ++k) s.cell_start[k] += s.cell_start[k - 1];
   s.cell_items.resize(s.reflex.size());
   {
     std::vector<int> fill(s.cell_start.begin(), s.cell_start.end() - 1);
     for (int w : s.reflex)
-      s.cell_items[size_t(fill[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx))]++)] = w;
+      s.cell_items[size_t(
+          fill[size_t(cell(q[size_t(w)][1], y0, sy)) * size_t(g) + size_t(cell(q[size_t(w)][0], x0, sx))]++)] = w;
   }
   // Work limit (see triangulate.h): beyond it the rest is cut as a fan.
   long budget = kEarClipWorkPerCorner * long(n);

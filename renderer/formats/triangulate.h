@@ -44,7 +44,6 @@ struct EarClipScratch {
 
 // Appends the triangles of polygon pts[0..n) as index triples into `out`.
 // Returns true when the work limit was spent (the rest cut as a fan).
-bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out,
-                         EarClipScratch& scratch);
+bool triangulate_polygon(const Vec3d* pts, int n, std::vector<std::array<int, 3>>& out, EarClipScratch& scratch);
 
 }  // namespace ra

@@ -25,7 +25,11 @@ std::string printable(const std::string& s) {
   out.reserve(s.size());
   for (std::size_t i = 0; i < s.size();) {
     const auto b = static_cast<unsigned char>(s[i]);
-    std::size_t len = b < 0x80 ? 1 : b >= 0xc2 && b <= 0xdf ? 2 : b >= 0xe0 && b <= 0xef ? 3 : b >= 0xf0 && b <= 0xf4 ? 4 : 0;
+    std::size_t len = b < 0x80                 ? 1
+                      : b >= 0xc2 && b <= 0xdf ? 2
+                      : b >= 0xe0 && b <= 0xef ? 3
+                      : b >= 0xf0 && b <= 0xf4 ? 4
+                                               : 0;
     for (std::size_t k = 1; k < len; ++k)
       if (i + k >= s.size() || (static_cast<unsigned char>(s[i + k]) & 0xc0) != 0x80) len = 0;
     if (len == 1 && (b < 0x20 || b == 0x7f)) len = 0;
@@ -90,8 +94,9 @@ void write_atomically(const std::filesystem::path& path,
 void check_output_name(const std::filesystem::path& path) {
   const std::size_t n = path.filename().string().size();
   if (n > NAME_MAX)
-    throw InputError(located(path.string(), 0, "file name too long (" + std::to_string(n) + " bytes; at most " +
-                                                   std::to_string(NAME_MAX) + ")"));
+    throw InputError(
+        located(path.string(), 0,
+                "file name too long (" + std::to_string(n) + " bytes; at most " + std::to_string(NAME_MAX) + ")"));
 }
 
 void check_output_path(const std::filesystem::path& path) {
@@ -115,13 +120,17 @@ void check_output_path(const std::filesystem::path& path) {
   if (st.type() == fs::file_type::not_found) return;
   if (ec) throw InputError(located(path.string(), 0, "cannot write: " + ec.message()));
   switch (st.type()) {
-    case fs::file_type::regular: return;
-    case fs::file_type::directory: throw InputError(located(path.string(), 0, "is a directory, not a file"));
-    case fs::file_type::fifo: throw InputError(located(path.string(), 0, "is a FIFO, not a file: not replaced"));
+    case fs::file_type::regular:
+      return;
+    case fs::file_type::directory:
+      throw InputError(located(path.string(), 0, "is a directory, not a file"));
+    case fs::file_type::fifo:
+      throw InputError(located(path.string(), 0, "is a FIFO, not a file: not replaced"));
     case fs::file_type::block:
     case fs::file_type::character:
       throw InputError(located(path.string(), 0, "is a device, not a file: not replaced"));
-    default: throw InputError(located(path.string(), 0, "is not a regular file: not replaced"));
+    default:
+      throw InputError(located(path.string(), 0, "is not a regular file: not replaced"));
   }
 }
 
@@ -191,8 +200,10 @@ void write_bytes_checked(const std::filesystem::path& file, const void* data, st
   while (left > 0 && !err) {
     const ssize_t w = ::write(fd, p, left);
     if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) err = w < 0 ? errno : ENOSPC;  // write() of 0 bytes: no room
-    else p += w, left -= std::size_t(w);
+    if (w <= 0)
+      err = w < 0 ? errno : ENOSPC;  // write() of 0 bytes: no room
+    else
+      p += w, left -= std::size_t(w);
   }
   // Some file systems report a full disk only when the data is flushed.
   if (!err && ::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) err = errno;

@@ -59,8 +59,8 @@ class OutputBatch {
   static bool stage(const std::filesystem::path& path, const std::filesystem::path& tmp);
 
  private:
-  std::vector<std::filesystem::path> outputs_;  // absolute, normalised
-  std::vector<std::filesystem::path> declared_;  // as given to declare_output()
+  std::vector<std::filesystem::path> outputs_;                                   // absolute, normalised
+  std::vector<std::filesystem::path> declared_;                                  // as given to declare_output()
   std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // tmp, final
   OutputBatch* outer_;
 };

@@ -26,7 +26,7 @@ struct Id {
 
 // stat() follows symlinks: a link to an input is that input.
 bool identity(const fs::path& p, Id& out) {
-  struct stat st{};
+  struct stat st {};
   if (::stat(p.c_str(), &st) != 0) return false;
   out = {st.st_dev, st.st_ino};
   return true;
@@ -58,9 +58,9 @@ Registry& registry() {
 }
 
 [[noreturn]] void refuse_input_as_output(const fs::path& out, const fs::path& in) {
-  throw InputError(located(out.string(), 0,
-                           "is also an input of this command (" + in.string() +
-                               "): it would be replaced; choose another output"));
+  throw InputError(
+      located(out.string(), 0,
+              "is also an input of this command (" + in.string() + "): it would be replaced; choose another output"));
 }
 
 }  // namespace

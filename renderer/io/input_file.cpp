@@ -16,13 +16,19 @@ std::string input_file_problem(const std::filesystem::path& path) {
   if (st.type() == fs::file_type::not_found) return "no such file";
   if (ec) return "cannot read: " + ec.message();
   switch (st.type()) {
-    case fs::file_type::regular: return "";
-    case fs::file_type::directory: return "is a directory, not a file";
-    case fs::file_type::fifo: return "is a FIFO, not a file";
-    case fs::file_type::socket: return "is a socket, not a file";
+    case fs::file_type::regular:
+      return "";
+    case fs::file_type::directory:
+      return "is a directory, not a file";
+    case fs::file_type::fifo:
+      return "is a FIFO, not a file";
+    case fs::file_type::socket:
+      return "is a socket, not a file";
     case fs::file_type::block:
-    case fs::file_type::character: return "is a device, not a file";
-    default: return "is not a regular file";
+    case fs::file_type::character:
+      return "is a device, not a file";
+    default:
+      return "is not a regular file";
   }
 }
 

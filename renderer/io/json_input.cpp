@@ -126,8 +126,10 @@ class Sax {
       throw InputError(located(file_, line, "number " + token + " overflows a double"));
     std::string msg = e.what();
     const auto at = msg.find("syntax error");
-    if (at != std::string::npos) msg = msg.substr(at);
-    else if (const auto b = msg.find("] "); b != std::string::npos) msg = msg.substr(b + 2);
+    if (at != std::string::npos)
+      msg = msg.substr(at);
+    else if (const auto b = msg.find("] "); b != std::string::npos)
+      msg = msg.substr(b + 2);
     throw InputError(located(file_, line, "invalid JSON: " + msg));
   }
 
@@ -137,9 +139,9 @@ class Sax {
   // Where each value sits, for JsonLines: the containers open around it.
   struct Frame {
     bool array;
-    long index;       // arrays: the current element
-    std::string prefix;  // the container's own pointer
-    std::string key;  // objects: the current member's token
+    long index;           // arrays: the current element
+    std::string prefix;   // the container's own pointer
+    std::string key;      // objects: the current member's token
     bool tracked = true;  // false below kMaxLineDepth: no lines recorded
   };
   // Lines are recorded 64 containers deep at most (deeper values take their
@@ -207,8 +209,7 @@ std::string json_error_text(const std::exception& e) {
   // nlohmann's wording, said as the other messages say it.
   if (msg.rfind("type must be ", 0) == 0) {
     const auto but = msg.find(", but is ");
-    if (but != std::string::npos)
-      return "expected a " + msg.substr(13, but - 13) + ", got " + msg.substr(but + 9);
+    if (but != std::string::npos) return "expected a " + msg.substr(13, but - 13) + ", got " + msg.substr(but + 9);
   }
   if (msg.rfind("key '", 0) == 0 && msg.size() > 15 && msg.compare(msg.size() - 11, 11, "' not found") == 0)
     return "needs \"" + msg.substr(5, msg.size() - 16) + "\"";

@@ -25,7 +25,8 @@ TEST(Located, AnOverlongFileOrMessageIsCutFromTheMiddleSayingHowMuch) {
 // Messages quote bad input: control bytes and bytes that are not UTF-8
 // come out as \xNN, so the message stays one printable line.
 TEST(Located, ControlAndNonUtf8BytesAreEscaped) {
-  EXPECT_EQ(located("f.ply", 9, std::string("malformed PLY value '") + '\0' + "'"), "f.ply:9: malformed PLY value '\\x00'");
+  EXPECT_EQ(located("f.ply", 9, std::string("malformed PLY value '") + '\0' + "'"),
+            "f.ply:9: malformed PLY value '\\x00'");
   EXPECT_EQ(located("a\nb", 0, "x\ry\xff\xfez"), "a\\x0ab: x\\x0dy\\xff\\xfez");
   EXPECT_EQ(located("f", 1, "caf\xc3\xa9 \xe2\x82\xac"), "f:1: caf\xc3\xa9 \xe2\x82\xac");  // UTF-8 kept
 }

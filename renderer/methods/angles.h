@@ -24,8 +24,7 @@ inline constexpr double MINUS_ZERO = -0.0001;
 // so (fa x fb).n is twice the signed area of PAB and MINUS_ZERO is an area
 // tolerance: it admits points up to 1e-4 / |AB| outside edge AB.
 template <class T>
-std::optional<T> accept(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
-                        bool cull) {
+std::optional<T> accept(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
   const Vec3<T> n_raw = cross(b - a, c - a);  // n = (b - a) x (c - a), as in the text
   if (cull && detail::culled(r, n_raw)) return std::nullopt;
   const T len = length(n_raw);

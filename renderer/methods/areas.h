@@ -37,8 +37,7 @@ T area(const Vec3<T>& v1, const Vec3<T>& v2, const Vec3<T>& v3) {
 // Barycentrics are not part of the method: detail::DecidesT
 // (point_barycentrics.h) computes them from the hit point after this decision.
 template <class T>
-std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C,
-                        bool cull) {
+std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C, bool cull) {
   // The listing's T.N and T.d: the plane dot(N, x) + d = 0 through A. N need
   // not be unit: t does not depend on its length.
   const Vec3<T> N = cross(B - A, C - A);

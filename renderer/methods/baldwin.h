@@ -31,7 +31,7 @@ Transform<T> prepare(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
   const int i = k + 1 == 3 ? 0 : k + 1;
   const int j = i + 1 == 3 ? 0 : i + 1;
   const T inv = T(1) / n[k];  // n[k] = e1[i] e2[j] - e1[j] e2[i]
-  Vec3<T> u, v;  // u.e1 = 1, u.e2 = 0; v.e1 = 0, v.e2 = 1; both 0 in column k
+  Vec3<T> u, v;               // u.e1 = 1, u.e2 = 0; v.e1 = 0, v.e2 = 1; both 0 in column k
   u[i] = e2[j] * inv;
   u[j] = -e2[i] * inv;
   v[i] = -e1[j] * inv;
@@ -65,8 +65,7 @@ bool any(const Ray<T>& r, const Transform<T>& tr, bool cull) {
 // The direct path: builds the map for this one call, then runs the test (for
 // the audit; meshes and benchmarks prepare once per triangle).
 template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                  const Vec3<T>& c, bool cull) {
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
   return hit(r, prepare(a, b, c), cull);
 }
 

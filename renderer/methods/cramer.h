@@ -15,8 +15,7 @@ namespace ra::cramer {
 // Shirley's FCG, which the lab follows, has the minus). As printed, every hit
 // in front of the ray would come out behind it, so we use the minus sign.
 template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B,
-                                  const Vec3<T>& C, bool cull) {
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C, bool cull) {
   const T a = A.x - B.x, b = A.y - B.y, c = A.z - B.z;
   const T d = A.x - C.x, e = A.y - C.y, f = A.z - C.z;
   const T g = r.d.x, h = r.d.y, i = r.d.z;

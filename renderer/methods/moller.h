@@ -13,8 +13,7 @@ namespace ra::moller {
 // The determinant threshold of the paper's EPSILON: exactly 0 here, so that
 // only truly parallel rays are rejected; a tolerance would be a silent bias.
 template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                  const Vec3<T>& c, bool cull) {
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
   const Vec3<T> e1 = b - a, e2 = c - a;
   const Vec3<T> p = cross(r.d, e2);
   const T det = dot(e1, p);

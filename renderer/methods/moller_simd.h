@@ -36,12 +36,15 @@ struct alignas(32) Tri4 {
   }
 };
 
-template <class T> struct Lanes;
-template <> struct Lanes<float> {
+template <class T>
+struct Lanes;
+template <>
+struct Lanes<float> {
   typedef float V __attribute__((vector_size(16)));
   typedef std::int32_t M __attribute__((vector_size(16)));
 };
-template <> struct Lanes<double> {
+template <>
+struct Lanes<double> {
   typedef double V __attribute__((vector_size(32)));
   typedef std::int64_t M __attribute__((vector_size(32)));
 };

@@ -51,16 +51,19 @@ void random_and_edge_rays(std::uint64_t seed) {
     Vec3<T> v[4][3];
     for (auto& tri : v)
       for (auto& p : tri) p = point();
-    if (iter % 7 == 0) v[1][2] = v[1][1];                       // degenerate: two equal vertices
+    if (iter % 7 == 0) v[1][2] = v[1][1];                         // degenerate: two equal vertices
     if (iter % 11 == 0) v[2][2] = v[2][0] + (v[2][1] - v[2][0]);  // (nearly) collinear
     Ray<T> r;
     r.o = Vec3<T>(T(3 * u(rng)), T(3 * u(rng)), T(3 * u(rng)));
     // Aim at a point of triangle 0: a vertex, an edge point or an interior point.
     const int kind = iter % 4;
     Vec3<T> target;
-    if (kind == 0) target = v[0][iter % 3];
-    else if (kind == 1) target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng));
-    else target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng) * 0.5) + (v[0][2] - v[0][0]) * T(w(rng) * 0.5);
+    if (kind == 0)
+      target = v[0][iter % 3];
+    else if (kind == 1)
+      target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng));
+    else
+      target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng) * 0.5) + (v[0][2] - v[0][0]) * T(w(rng) * 0.5);
     r.d = target - r.o;
     if (iter % 13 == 0) r.d = v[0][1] - v[0][0];  // parallel to an edge
     if (iter % 17 == 0) r.d.z = T(0);             // an axis-parallel component
@@ -93,11 +96,10 @@ void signed_zero_rays() {
           r.o = Vec3<T>(ox, oy, T(1));
           r.d = Vec3<T>(dx, dy, T(-1));
           r.tmin = nz;
-          const Vec3<T> v[4][3] = {
-              {Vec3<T>(z, z, z), Vec3<T>(T(1), z, z), Vec3<T>(z, T(1), z)},
-              {Vec3<T>(nz, nz, nz), Vec3<T>(z, T(1), z), Vec3<T>(T(1), z, z)},
-              {Vec3<T>(T(-1), z, z), Vec3<T>(z, z, z), Vec3<T>(z, T(-1), z)},
-              {Vec3<T>(z, z, T(1)), Vec3<T>(T(1), z, T(1)), Vec3<T>(z, T(1), T(1))}};
+          const Vec3<T> v[4][3] = {{Vec3<T>(z, z, z), Vec3<T>(T(1), z, z), Vec3<T>(z, T(1), z)},
+                                   {Vec3<T>(nz, nz, nz), Vec3<T>(z, T(1), z), Vec3<T>(T(1), z, z)},
+                                   {Vec3<T>(T(-1), z, z), Vec3<T>(z, z, z), Vec3<T>(z, T(-1), z)},
+                                   {Vec3<T>(z, z, T(1)), Vec3<T>(T(1), z, T(1)), Vec3<T>(z, T(1), T(1))}};
           for (bool cull : {false, true}) hits += compare_block(r, v, cull);
         }
   EXPECT_GT(hits, 0);

@@ -13,8 +13,7 @@ namespace ra::detail {
 // document's tolerance accepted outside the triangle reports a slightly
 // negative coordinate rather than a misleading positive one.
 template <class T>
-TriangleHit<T> hit_from_point(T t, const Vec3<T>& p, const Vec3<T>& a, const Vec3<T>& b,
-                              const Vec3<T>& c) {
+TriangleHit<T> hit_from_point(T t, const Vec3<T>& p, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
   const Vec3<T> e1 = b - a, e2 = c - a, ap = p - a;
   const Vec3<T> n = cross(e1, e2);
   const T inv = T(1) / dot(n, n);
@@ -42,8 +41,8 @@ bool culled(const Ray<T>& r, const Vec3<T>& n) {
 template <class D>
 struct DecidesT {
   template <class T>
-  static std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                           const Vec3<T>& c, bool cull) {
+  static std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c,
+                                           bool cull) {
     const std::optional<T> t = D::template accept<T>(r, a, b, c, cull);
     if (!t) return std::nullopt;
     return hit_from_point(*t, r.at(*t), a, b, c);

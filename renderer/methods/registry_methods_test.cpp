@@ -14,8 +14,8 @@ TEST(RegistryMethods, OrderAndKinds) {
   std::vector<std::string> names;
   for (const auto& m : methods()) names.push_back(m.name);
   const std::vector<std::string> expected{
-      "angles", "cramer",      "areas",             "triple", "sameside", "moller", "watertight",
-      "baldwin", "exact", "kraus", "codeproject", "codeproject-fixed", "stable", "plane"};
+      "angles",  "cramer", "areas", "triple",      "sameside",          "moller", "watertight",
+      "baldwin", "exact",  "kraus", "codeproject", "codeproject-fixed", "stable", "plane"};
   EXPECT_EQ(names, expected);
   EXPECT_EQ(method_names(Kind::sphere), "kraus, codeproject, codeproject-fixed, stable");
   EXPECT_EQ(default_method(Kind::triangle).name, "moller");

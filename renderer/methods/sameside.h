@@ -27,8 +27,7 @@ bool same_side(const Vec3<T>& p1, const Vec3<T>& p2, const Vec3<T>& a, const Vec
 // Barycentrics are not part of the method: detail::DecidesT
 // (point_barycentrics.h) computes them from the hit point after this decision.
 template <class T>
-std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C,
-                        bool cull) {
+std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C, bool cull) {
   // getNormal computes (C - A) x (B - A): the opposite of registry.h's front
   // normal. GetInterSect divides two dots with it, so the sign cancels; only
   // culling needs the registry's orientation, and flips it back.
@@ -41,8 +40,7 @@ std::optional<T> accept(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, con
   if (!detail::in_window(r, u)) return std::nullopt;
   const Vec3<T> p = r.at(u);
   // PointInTriangle: edge BC against A, edge AC against B, edge AB against C.
-  if (!(same_side(p, A, B, C) && same_side(p, B, A, C) && same_side(p, C, A, B)))
-    return std::nullopt;
+  if (!(same_side(p, A, B, C) && same_side(p, B, A, C) && same_side(p, C, A, B))) return std::nullopt;
   return u;
 }
 

@@ -19,8 +19,8 @@ bool roots(const Ray<T>& r, const Vec3<T>& center, T radius, T& t1, T& t2) {
   const T cx = center.x, cy = center.y, cz = center.z;
   const T A = (vx * vx + vy * vy + vz * vz);
   const T B = T(2) * (px * vx + py * vy + pz * vz - vx * cx - vy * cy - vz * cz);
-  const T C = px * px - T(2) * px * cx + cx * cx + py * py - T(2) * py * cy + cy * cy + pz * pz -
-              T(2) * pz * cz + cz * cz - radius * radius;
+  const T C = px * px - T(2) * px * cx + cx * cx + py * py - T(2) * py * cy + cy * cy + pz * pz - T(2) * pz * cz +
+              cz * cz - radius * radius;
   const T D = B * B - T(4) * A * C;
   if (!(D >= T(0))) return false;
   t1 = (-B - std::sqrt(D)) / (T(2) * A);

@@ -31,8 +31,7 @@ class SphereMethod : public ::testing::Test {
   static constexpr T tol = sizeof(T) == 4 ? T(1e-5) : T(1e-12);
   const V c{1, 2, 3};
   const T radius = 2;
-  std::optional<SurfaceHit<T>> hit(V o_rel, V d, T tmin = 0,
-                                   T tmax = std::numeric_limits<T>::infinity()) const {
+  std::optional<SurfaceHit<T>> hit(V o_rel, V d, T tmin = 0, T tmax = std::numeric_limits<T>::infinity()) const {
     const auto& k = find_method(P::name)->template sphere<T>();
     const Ray<T> r{c + o_rel, d, tmin, tmax};
     const auto h = k.hit(r, c, radius);
@@ -76,9 +75,9 @@ TYPED_TEST(SphereMethod, NonUnitDirectionKeepsCallersParametrisation) {
 }
 
 TYPED_TEST(SphereMethod, Misses) {
-  EXPECT_FALSE(this->hit({3, 0, 5}, {0, 0, -1}));   // passes at distance 3 > 2
-  EXPECT_FALSE(this->hit({0, 0, 5}, {0, 0, 1}));    // sphere behind: roots -7, -3
-  EXPECT_FALSE(this->hit({0, 0, 5}, {1, 0, 0}));    // parallel to the tangent plane, above
+  EXPECT_FALSE(this->hit({3, 0, 5}, {0, 0, -1}));  // passes at distance 3 > 2
+  EXPECT_FALSE(this->hit({0, 0, 5}, {0, 0, 1}));   // sphere behind: roots -7, -3
+  EXPECT_FALSE(this->hit({0, 0, 5}, {1, 0, 0}));   // parallel to the tangent plane, above
 }
 
 // From inside (1 above the centre, going down): roots -1 and 3; the exit.
@@ -198,8 +197,8 @@ TEST(Plane, HitsBothSidesAndHonoursWindow) {
   h = k.hit(Rayd{{1, 1, -1}, {0, 0, 2}}, n, 2.0);  // from below, |d| = 2
   ASSERT_TRUE(h);
   EXPECT_EQ(h->t, 1.5);
-  EXPECT_FALSE(k.hit(Rayd{{1, 1, 5}, {1, 0, 0}}, n, 2.0));         // parallel
-  EXPECT_FALSE(k.hit(Rayd{{1, 1, 5}, {0, 0, 1}}, n, 2.0));         // behind
+  EXPECT_FALSE(k.hit(Rayd{{1, 1, 5}, {1, 0, 0}}, n, 2.0));           // parallel
+  EXPECT_FALSE(k.hit(Rayd{{1, 1, 5}, {0, 0, 1}}, n, 2.0));           // behind
   EXPECT_FALSE(k.hit(Rayd{{1, 1, 5}, {0, 0, -1}, 0, 2.5}, n, 2.0));  // beyond tmax
   EXPECT_FALSE(k.any(Rayd{{1, 1, 5}, {0, 0, -1}, 3.5}, n, 2.0));     // before tmin
 }

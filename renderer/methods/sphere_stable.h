@@ -17,8 +17,8 @@ template <class T>
 std::optional<SurfaceHit<T>> hit(const Ray<T>& r, const Vec3<T>& center, T radius) {
   const Vec3<T> f = r.o - center;
   const T a = dot(r.d, r.d);
-  const T b = -dot(f, r.d);  // b' = -(f.d): half of -B
-  const Vec3<T> l = f + r.d * (b / a);  // f minus its projection on d
+  const T b = -dot(f, r.d);                    // b' = -(f.d): half of -B
+  const Vec3<T> l = f + r.d * (b / a);         // f minus its projection on d
   const T disc = radius * radius - dot(l, l);  // (per unit a) discriminant / 4
   if (!(disc >= T(0))) return std::nullopt;
   const T s = std::sqrt(a * disc);

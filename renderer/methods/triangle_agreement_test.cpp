@@ -57,8 +57,7 @@ Sample make_sample(std::mt19937_64& rng) {
   Vec3d dir;
   do {
     dir = {u(rng), u(rng), u(rng)};
-  } while (length(dir) > 1 || length(dir) < 0.1 ||
-           std::abs(dot(normalize(dir), normalize(n))) < 0.1);
+  } while (length(dir) > 1 || length(dir) < 0.1 || std::abs(dot(normalize(dir), normalize(n))) < 0.1);
   dir = dir * (0.5 + 1.5 * u01(rng));  // not unit length
   const double t = 0.5 + 4.5 * u01(rng);
   const bool behind = u01(rng) < 0.1;  // the triangle behind the origin
@@ -89,15 +88,14 @@ TEST(TriangleAgreement, AllMethodsMatchConstructionFarFromEdges) {
       const auto h = k.hit(s.ray, s.a, s.b, s.c, s.cull);
       const auto hp = k.hit_pre(s.ray, pre, s.cull);
       const bool ok = h.has_value() == s.expect_hit && hp.has_value() == s.expect_hit &&
-                      (!h || (std::abs(h->t - s.t) <= 1e-9 * s.t &&
-                              std::abs(h->b1 - s.b1) <= 1e-9 && std::abs(h->b2 - s.b2) <= 1e-9));
+                      (!h || (std::abs(h->t - s.t) <= 1e-9 * s.t && std::abs(h->b1 - s.b1) <= 1e-9 &&
+                              std::abs(h->b2 - s.b2) <= 1e-9));
       if (!ok) {
         ++failures;
-        ADD_FAILURE() << m->name << " disagrees on ray " << i << " (seed " << kSeed
-                      << "): expected " << (s.expect_hit ? "hit" : "miss") << " t=" << s.t
-                      << " b=(" << s.b1 << ", " << s.b2 << "), got "
-                      << (h ? "hit t=" + std::to_string(h->t) + " b=(" + std::to_string(h->b1) +
-                                  ", " + std::to_string(h->b2) + ")"
+        ADD_FAILURE() << m->name << " disagrees on ray " << i << " (seed " << kSeed << "): expected "
+                      << (s.expect_hit ? "hit" : "miss") << " t=" << s.t << " b=(" << s.b1 << ", " << s.b2 << "), got "
+                      << (h ? "hit t=" + std::to_string(h->t) + " b=(" + std::to_string(h->b1) + ", " +
+                                  std::to_string(h->b2) + ")"
                             : std::string("miss"))
                       << " cull=" << s.cull << " o=" << s.ray.o << " d=" << s.ray.d;
       }
@@ -127,9 +125,7 @@ int edge_leaks(const char* name, std::uint64_t seed, int n, int* tried_out = nul
     // same side, not grazing); a ray that only touches a ridge may miss both.
     const Vec3d n1 = normalize(cross(q - p, x - p)), n2 = normalize(cross(p - q, y - q));
     const Vec3d dn = normalize(aim - o);
-    if (!(dot(dn, n1) * dot(dn, n2) > 0) || std::abs(dot(dn, n1)) < 0.05 ||
-        std::abs(dot(dn, n2)) < 0.05)
-      continue;
+    if (!(dot(dn, n1) * dot(dn, n2) > 0) || std::abs(dot(dn, n1)) < 0.05 || std::abs(dot(dn, n2)) < 0.05) continue;
     const Ray<T> r{Vec3<T>(o), Vec3<T>(aim - o)};
     // Consistent winding (P, Q, X) and (Q, P, Y), as in a closed mesh.
     ++tried;
@@ -148,8 +144,7 @@ TEST(TriangleAgreement, WatertightNeverLeaksThroughSharedEdge) {
   int tried = 0;
   const int moller = edge_leaks<float>("moller", seed, 20000, &tried);
   const int baldwin = edge_leaks<float>("baldwin", seed, 20000);
-  std::printf("shared-edge leaks in float out of %d rays: moller %d, baldwin %d\n", tried, moller,
-              baldwin);
+  std::printf("shared-edge leaks in float out of %d rays: moller %d, baldwin %d\n", tried, moller, baldwin);
 }
 
 }  // namespace

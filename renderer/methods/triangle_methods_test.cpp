@@ -73,10 +73,9 @@ class TriangleMethod : public ::testing::Test {
 };
 
 using AllTriangleMethods =
-    ::testing::Types<Case<kAngles, float>, Case<kAngles, double>, Case<kCramer, float>,
-                     Case<kCramer, double>, Case<kAreas, float>, Case<kAreas, double>,
-                     Case<kTriple, float>, Case<kTriple, double>, Case<kSameside, float>,
-                     Case<kSameside, double>, Case<kMoller, float>, Case<kMoller, double>,
+    ::testing::Types<Case<kAngles, float>, Case<kAngles, double>, Case<kCramer, float>, Case<kCramer, double>,
+                     Case<kAreas, float>, Case<kAreas, double>, Case<kTriple, float>, Case<kTriple, double>,
+                     Case<kSameside, float>, Case<kSameside, double>, Case<kMoller, float>, Case<kMoller, double>,
                      Case<kWatertight, float>, Case<kWatertight, double>, Case<kBaldwin, float>,
                      Case<kBaldwin, double>>;
 

@@ -11,8 +11,7 @@ namespace ra::triple {
 // The document's names: Det, H, lambda2, lambda3 (its t is printed as gamma).
 // The system is A + l2 (B-A) + l3 (C-A) = O + t D, i.e. columns (B-A, C-A, -D).
 template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B,
-                                  const Vec3<T>& C, bool cull) {
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& A, const Vec3<T>& B, const Vec3<T>& C, bool cull) {
   const Vec3<T> AB = B - A, AC = C - A, minusD = -r.d;
   const Vec3<T> n = cross(AB, AC);
   const T Det = dot(n, minusD);

@@ -26,8 +26,7 @@ T edge(T px, T py, T qx, T qy) {
 }
 
 template <class T>
-std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                  const Vec3<T>& c, bool cull) {
+std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c, bool cull) {
   // Permute so the ray's largest |d| axis is z; swapping x and y when d.z < 0
   // keeps the winding, so the edge functions' sign is the sign of n.d.
   // (Plain arrays: indexing them is cheaper than Vec3's operator[] chain.)
@@ -71,10 +70,8 @@ std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<
   // Scaled hit distance, compared with the window before dividing.
   const T az = Sz * A[kz], bz = Sz * B[kz], cz = Sz * C[kz];
   const T t_scaled = e0 * az + e1 * bz + e2 * cz;
-  if (det < T(0) && (t_scaled >= T(0) || t_scaled > r.tmin * det || t_scaled < r.tmax * det))
-    return std::nullopt;
-  if (det > T(0) && (t_scaled <= T(0) || t_scaled < r.tmin * det || t_scaled > r.tmax * det))
-    return std::nullopt;
+  if (det < T(0) && (t_scaled >= T(0) || t_scaled > r.tmin * det || t_scaled < r.tmax * det)) return std::nullopt;
+  if (det > T(0) && (t_scaled <= T(0) || t_scaled < r.tmin * det || t_scaled > r.tmax * det)) return std::nullopt;
   const T inv_det = T(1) / det;
   const T t = t_scaled * inv_det;
   // The scaled comparison can differ from t's by a rounding; the window is exact.
@@ -112,8 +109,7 @@ std::optional<TriangleHit<T>> hit(const Ray<T>& r, const Vec3<T>& a, const Vec3<
   const T delta_x = gamma<T>(5) * (max_xt + std::abs(Sx) * max_zt);
   const T delta_y = gamma<T>(5) * (max_yt + std::abs(Sy) * max_zt);
   const T delta_e = T(2) * (gamma<T>(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-  const T delta_t =
-      T(3) * (gamma<T>(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * std::abs(inv_det);
+  const T delta_t = T(3) * (gamma<T>(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * std::abs(inv_det);
   if (t <= delta_t) return std::nullopt;
 
   return TriangleHit<T>{t, e1 * inv_det, e2 * inv_det};

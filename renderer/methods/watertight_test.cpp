@@ -15,8 +15,7 @@ namespace ra {
 namespace {
 
 template <class T>
-std::optional<TriangleHit<T>> wt(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                 const Vec3<T>& c) {
+std::optional<TriangleHit<T>> wt(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
   return watertight::hit(r, a, b, c, false);
 }
 

@@ -27,8 +27,8 @@ std::string first_line(std::string s) {
 
 // Encodes through an in-memory proxy: OIIO's PNG writer does not report a
 // failed write to a file (full disk), so the caller writes the bytes itself.
-bool encode(const OIIO::ImageSpec& spec, const void* pixels, const OIIO::ImageBuf* buf,
-            std::vector<unsigned char>* out, std::string* err) {
+bool encode(const OIIO::ImageSpec& spec, const void* pixels, const OIIO::ImageBuf* buf, std::vector<unsigned char>* out,
+            std::string* err) {
   OIIO::Filesystem::IOVecOutput proxy(*out);
   auto o = OIIO::ImageOutput::create("png");
   if (!o) {
@@ -41,8 +41,8 @@ bool encode(const OIIO::ImageSpec& spec, const void* pixels, const OIIO::ImageBu
   return ok;
 }
 
-bool encode_png(int w, int h, int bits, const void* pixels, const char* colorspace,
-                std::vector<unsigned char>* out, std::string* err) try {
+bool encode_png(int w, int h, int bits, const void* pixels, const char* colorspace, std::vector<unsigned char>* out,
+                std::string* err) try {
   OIIO::ImageSpec spec(w, h, 3, bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
   spec.attribute("oiio:ColorSpace", colorspace);
   return encode(spec, pixels, nullptr, out, err);
@@ -130,8 +130,8 @@ OIIO::ImageBuf to_buf(int w, int h, const float* rgb) {
 void compare(int w, int h, const float* a, const float* b, float fail, float warn, CompareStats* out) {
   const OIIO::ImageBuf A = to_buf(w, h, a), B = to_buf(w, h, b);
   const auto r = OIIO::ImageBufAlgo::compare(A, B, fail, warn);
-  *out = CompareStats{r.meanerror, r.rms_error, r.PSNR, r.maxerror, r.maxx, r.maxy, r.maxc,
-                      long(r.nwarn), long(r.nfail)};
+  *out =
+      CompareStats{r.meanerror, r.rms_error, r.PSNR, r.maxerror, r.maxx, r.maxy, r.maxc, long(r.nwarn), long(r.nfail)};
 }
 
 void absdiff(int w, int h, const float* a, const float* b, float* out) {
@@ -171,7 +171,7 @@ extern "C" __attribute__((visibility("default"))) const Api* rayaudit_image_modu
     return true;
   }();
   (void)single;
-  static const Api api{ra::image_module::kVersion, sizeof(Api), encode_png, write_exr, open, read, close,
-                       compare, absdiff, rgb_png};
+  static const Api api{
+      ra::image_module::kVersion, sizeof(Api), encode_png, write_exr, open, read, close, compare, absdiff, rgb_png};
   return &api;
 }

@@ -4,8 +4,7 @@
 
 namespace ra {
 
-Camera::Camera(const CameraSpec& spec, int width, int height)
-    : origin_(spec.position), width_(width), height_(height) {
+Camera::Camera(const CameraSpec& spec, int width, int height) : origin_(spec.position), width_(width), height_(height) {
   const Vec3d f = normalize(spec.look_at - spec.position);
   // Right-handed: right = forward x up; POV gets the same frame from
   // `right -x*aspect` in its left-handed convention.

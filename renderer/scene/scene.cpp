@@ -38,8 +38,7 @@ std::string file_problem(const std::filesystem::path& p) {
 // keys were used, so that a misspelt key is an error rather than ignored.
 class ObjectReader {
  public:
-  ObjectReader(const json& j, std::string path, const std::string& file)
-      : j_(j), path_(std::move(path)), file_(file) {
+  ObjectReader(const json& j, std::string path, const std::string& file) : j_(j), path_(std::move(path)), file_(file) {
     if (!j_.is_object()) fail(path_, "expected an object");
   }
 
@@ -81,8 +80,7 @@ class ObjectReader {
     const json& v = j_.at(key);
     if (!v.is_number_integer()) fail(at(key), "expected an integer, got " + std::string(v.type_name()));
     const long long x = v.get<long long>();
-    if (x < lo || x > hi)
-      fail(at(key), "must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+    if (x < lo || x > hi) fail(at(key), "must be between " + std::to_string(lo) + " and " + std::to_string(hi));
     return int(x);
   }
   bool boolean(const std::string& key, bool def) {
@@ -160,8 +158,7 @@ std::filesystem::path resolve(const std::filesystem::path& scene_file, const std
   return q;
 }
 
-Material parse_material(const json& j, const std::string& path, const std::filesystem::path& file,
-                        Material m = {}) {
+Material parse_material(const json& j, const std::string& path, const std::filesystem::path& file, Material m = {}) {
   ObjectReader r(j, path, file.string());
   m.color = r.color("color", m.color);
   m.ambient = r.color("ambient", m.ambient);
@@ -198,10 +195,14 @@ Material parse_material(const json& j, const std::string& path, const std::files
     b.file = resolve(file, path_string(br, "file"));
     if (const auto why = file_problem(b.file); !why.empty()) br.fail(br.at("file"), why);
     const std::string v = br.string("variant", "height");
-    if (v == "height") b.variant = BumpVariant::height;
-    else if (v == "normal-map") b.variant = BumpVariant::normal_map;
-    else if (v == "pov") b.variant = BumpVariant::pov;
-    else br.fail(br.at("variant"), "expected \"height\", \"normal-map\" or \"pov\", got \"" + v + "\"");
+    if (v == "height")
+      b.variant = BumpVariant::height;
+    else if (v == "normal-map")
+      b.variant = BumpVariant::normal_map;
+    else if (v == "pov")
+      b.variant = BumpVariant::pov;
+    else
+      br.fail(br.at("variant"), "expected \"height\", \"normal-map\" or \"pov\", got \"" + v + "\"");
     b.strength = br.number("strength", b.variant == BumpVariant::pov ? 0.5 : 1.0);
     b.filter = parse_filter(br, "filter");
     br.finish();
@@ -221,8 +222,7 @@ Object parse_object(const json& j, const std::string& path, const std::filesyste
   ObjectReader r(j, path, file.string());
   Object o;
   int kinds = int(r.has("sphere")) + int(r.has("plane")) + int(r.has("triangle")) + int(r.has("mesh"));
-  if (kinds != 1)
-    r.fail(path, "an object needs exactly one of \"sphere\", \"plane\", \"triangle\", \"mesh\"");
+  if (kinds != 1) r.fail(path, "an object needs exactly one of \"sphere\", \"plane\", \"triangle\", \"mesh\"");
   if (r.has("sphere")) {
     o.kind = Object::Kind::sphere;
     ObjectReader s(r.get("sphere"), r.at("sphere"), file.string());
@@ -270,9 +270,12 @@ Object parse_object(const json& j, const std::string& path, const std::filesyste
       }
     }
     const std::string shading = r.string("shading", "flat");
-    if (shading == "flat") place.shading = Shading::flat;
-    else if (shading == "smooth") place.shading = Shading::smooth;
-    else r.fail(r.at("shading"), "expected \"flat\" or \"smooth\", got \"" + shading + "\"");
+    if (shading == "flat")
+      place.shading = Shading::flat;
+    else if (shading == "smooth")
+      place.shading = Shading::smooth;
+    else
+      r.fail(r.at("shading"), "expected \"flat\" or \"smooth\", got \"" + shading + "\"");
     if (r.has("material")) {
       place.material_override = parse_material(r.get("material"), r.at("material"), file);
     }
@@ -299,7 +302,8 @@ Object parse_object(const json& j, const std::string& path, const std::filesyste
 Scene parse_scene_json(const std::string& text, const std::filesystem::path& file) {
   // Line-located errors, overflowing numbers at their place, duplicate keys refused.
   const json j = parse_json_text(text, file.string());
-  if (!j.is_object()) throw InputError(located(file.string(), 0, "expected a JSON object {\"width\": ..., \"objects\": [...]}"));
+  if (!j.is_object())
+    throw InputError(located(file.string(), 0, "expected a JSON object {\"width\": ..., \"objects\": [...]}"));
   Scene s;
   s.file = file;
   ObjectReader r(j, "", file.string());
@@ -427,8 +431,7 @@ std::string cull_unsafe_reason(const TriangleSet& set) {
   const Vec3d o = set.positions[set.triangles[0].v[0]];
   double volume6 = 0;
   for (const auto& tri : set.triangles)
-    volume6 += dot(set.positions[tri.v[0]] - o,
-                   cross(set.positions[tri.v[1]] - o, set.positions[tri.v[2]] - o));
+    volume6 += dot(set.positions[tri.v[0]] - o, cross(set.positions[tri.v[1]] - o, set.positions[tri.v[2]] - o));
   if (!(volume6 > 0)) return "its triangles face inward (negative signed volume)";
   return "";
 }

@@ -132,7 +132,7 @@ struct Scene {
   bool camera_given = false;  // false: frame the scene's bounding sphere
   Color background{0, 0, 0};
   Color ambient_light{1, 1, 1};
-  int max_depth = 5;          // POV's max_trace_level
+  int max_depth = 5;  // POV's max_trace_level
   double adc_bailout = 1.0 / 255.0;
   std::vector<PointLight> lights;
   bool lights_given = false;  // false: one white light at the camera

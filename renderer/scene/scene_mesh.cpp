@@ -11,9 +11,12 @@ namespace ra {
 Vec3d rotate_about(char axis, double a, const Vec3d& p) {
   const double c = std::cos(a), s = std::sin(a);
   switch (axis) {
-    case 'x': return {p.x, c * p.y - s * p.z, s * p.y + c * p.z};
-    case 'y': return {c * p.x + s * p.z, p.y, -s * p.x + c * p.z};
-    default: return {c * p.x - s * p.y, s * p.x + c * p.y, p.z};
+    case 'x':
+      return {p.x, c * p.y - s * p.z, s * p.y + c * p.z};
+    case 'y':
+      return {c * p.x + s * p.z, p.y, -s * p.x + c * p.z};
+    default:
+      return {c * p.x - s * p.y, s * p.x + c * p.y, p.z};
   }
 }
 
@@ -95,8 +98,11 @@ void check_mesh_format(const std::filesystem::path& file) {
   for (auto& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
   // Read as OBJ, a PLY or OFF file was "NUL byte in a text file" or "invalid JSON".
   if (ext == ".ply" || ext == ".off")
-    throw InputError(located(file.string(), 0, "a " + ext.substr(1) + " mesh: scenes take OBJ; convert it first "
-                                                "(rayaudit convert " + file.filename().string() + " -o NAME.obj)"));
+    throw InputError(located(file.string(), 0,
+                             "a " + ext.substr(1) +
+                                 " mesh: scenes take OBJ; convert it first "
+                                 "(rayaudit convert " +
+                                 file.filename().string() + " -o NAME.obj)"));
 }
 
 std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {
@@ -158,8 +164,9 @@ std::shared_ptr<TriangleSet> load_placed_mesh(const MeshPlacement& place) {
     }
   }
   if (zero_faces)
-    warnings.push_back(set->name + ": " + std::to_string(zero_faces) + " triangle(s) use a zero-length vn (first: vn #" +
-                       std::to_string(first_zero + 1) + " of the file); they take normals computed from the mesh, "
+    warnings.push_back(set->name + ": " + std::to_string(zero_faces) +
+                       " triangle(s) use a zero-length vn (first: vn #" + std::to_string(first_zero + 1) +
+                       " of the file); they take normals computed from the mesh, "
                        "as triangles without vn do");
   for (const auto& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   return set;

@@ -52,8 +52,7 @@ TEST(SceneFile, UnknownKeyNamesItsPath) {
 }
 
 TEST(SceneFile, WrongTypeNamesItsPath) {
-  EXPECT_EQ(error_of(R"({"camera": {"vfov": "wide"}})"),
-            "s.json: /camera/vfov: expected a number, got string");
+  EXPECT_EQ(error_of(R"({"camera": {"vfov": "wide"}})"), "s.json: /camera/vfov: expected a number, got string");
   // POV-Ray's camera refuses |look_at - position|^2 < 1e-10; so does ours.
   EXPECT_EQ(error_of(R"({"camera": {"position": [0, 0, 1e-6], "look_at": [0, 0, 0]}})"),
             "s.json: /camera/look_at: must be at least 1e-5 from the position (POV-Ray refuses a nearer one)");

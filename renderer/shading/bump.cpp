@@ -49,8 +49,8 @@ Vec3d bump_height(const Vec3d& n, const Texture& deriv, TextureFilter filter, do
   return normalized_or(n + (basis.tu * s.x - basis.tv * s.y) * strength, n);
 }
 
-Vec3d bump_normal_map(const Vec3d& n, const Texture& map, TextureFilter filter, double strength, double u,
-                      double v, const UvBasis& basis) {
+Vec3d bump_normal_map(const Vec3d& n, const Texture& map, TextureFilter filter, double strength, double u, double v,
+                      const UvBasis& basis) {
   const Vec3d c = map.sample(u, v, filter);
   const Vec3d d = c * 2.0 - Vec3d{1, 1, 1};
   if (d.x == 0 && d.y == 0 && d.z > 0) return n;  // no deflection
@@ -69,11 +69,20 @@ Vec3d bump_pov(const Vec3d& n, const Texture& image, TextureFilter filter, doubl
   const double g1 = tap(x, y);
   x -= 1;
   y += 1;
-  if (x < 0) x += w; else if (x >= w) x -= w;
-  if (y < 0) y += h; else if (y >= h) y -= h;
+  if (x < 0)
+    x += w;
+  else if (x >= w)
+    x -= w;
+  if (y < 0)
+    y += h;
+  else if (y >= h)
+    y -= h;
   const double g2 = tap(x, y);
   x += 2;
-  if (x < 0) x += w; else if (x >= w) x -= w;
+  if (x < 0)
+    x += w;
+  else if (x >= w)
+    x -= w;
   const double g3 = tap(x, y);
   const Vec3d p1{0, bump_size * g1, 0}, p2{-1, bump_size * g2, 1}, p3{1, bump_size * g3, 1};
   const Vec3d bn = normalize(cross(p3 - p2, p1 - p2));

@@ -52,8 +52,8 @@ Texture height_derivatives(const Texture& height);
 Vec3d bump_height(const Vec3d& n, const Texture& deriv, TextureFilter filter, double strength, double u, double v,
                   const UvBasis& basis);
 // Variant 1.
-Vec3d bump_normal_map(const Vec3d& n, const Texture& map, TextureFilter filter, double strength, double u,
-                      double v, const UvBasis& basis);
+Vec3d bump_normal_map(const Vec3d& n, const Texture& map, TextureFilter filter, double strength, double u, double v,
+                      const UvBasis& basis);
 // POV-Ray's bump_map; `n` faces the ray; bump_size = strength.
 Vec3d bump_pov(const Vec3d& n, const Texture& image, TextureFilter filter, double bump_size, double u, double v);
 

@@ -50,8 +50,8 @@ inline std::optional<double> fresnel(double ior, double cos_i) {
 // interior list. ComputeRefraction's rules for the ratio of indices, where
 // ior_of(object) is that object's interior ior.
 struct RefractionStep {
-  double ior;                 // n1 / n2 for Heckbert's formula
-  std::vector<int> interiors; // the refracted ray's list
+  double ior;                  // n1 / n2 for Heckbert's formula
+  std::vector<int> interiors;  // the refracted ray's list
 };
 template <class IorOf>
 RefractionStep refraction_step(const std::vector<int>& interiors, int object, IorOf&& ior_of) {
@@ -92,8 +92,10 @@ double relative_ior(const std::vector<int>& interiors, int object, IorOf&& ior_o
 inline std::optional<Vec3d> refract(const Vec3d& D, const Vec3d& N, double ior) {
   double n = dot(D, N);
   Vec3d local = N;
-  if (n <= 0.0) n = -n;
-  else local = -N;
+  if (n <= 0.0)
+    n = -n;
+  else
+    local = -N;
   double t = 1.0 + ior * ior * (n * n - 1.0);
   if (t < 0.0) return std::nullopt;
   t = ior * n - std::sqrt(t);

@@ -25,7 +25,11 @@ int wrap_int(int i, int n) {
 }  // namespace
 
 Texture::Texture(StoredPixels&& p)
-    : width(p.width), height(p.height), channels(p.channels), rgb(std::move(p.f)), u8(std::move(p.u8)),
+    : width(p.width),
+      height(p.height),
+      channels(p.channels),
+      rgb(std::move(p.f)),
+      u8(std::move(p.u8)),
       u16(std::move(p.u16)) {}
 
 Vec3d Texture::texel(int x, int y) const {

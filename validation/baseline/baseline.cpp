@@ -40,8 +40,9 @@ void check_audit(const json& j, bool baseline) {
   if (j.contains("cases") && !j.contains("subjects"))
     throw Mismatch(std::string(which(baseline)) + " is an `audit --cases` table, not an audit of families");
   if (j.contains("shard"))
-    throw Mismatch(std::string(which(baseline)) + " is one shard's partial counts: merge the shards first "
-                                                  "(rayaudit audit merge)");
+    throw Mismatch(std::string(which(baseline)) +
+                   " is one shard's partial counts: merge the shards first "
+                   "(rayaudit audit merge)");
   for (const char* key : {"seed", "rays_per_family", "subjects", "cells"})
     if (!j.contains(key)) throw Mismatch(std::string(which(baseline)) + " has no '" + key + "': not an audit's JSON");
   if (!j["cells"].is_array() || !j["subjects"].is_array())
@@ -87,8 +88,10 @@ std::string join(const std::set<std::string>& s) {
 
 std::string number(double v) {
   char buf[40];
-  if (v == double(std::uint64_t(v)) && v < 1e15) std::snprintf(buf, sizeof buf, "%llu", (unsigned long long)v);
-  else std::snprintf(buf, sizeof buf, "%.4g", v);
+  if (v == double(std::uint64_t(v)) && v < 1e15)
+    std::snprintf(buf, sizeof buf, "%llu", (unsigned long long)v);
+  else
+    std::snprintf(buf, sizeof buf, "%.4g", v);
   return buf;
 }
 
@@ -131,7 +134,8 @@ Diff compare(const json& base, const json& cur, const Scope& scope) {
     if (!base_subjects.count(s)) d.new_subjects.push_back(s);
   for (const auto& s : base_subjects)
     if (!cur_subjects.count(s))
-      throw Mismatch("subject '" + s + "' of the baseline is not in this run (this run has: " + join(cur_subjects) + ")");
+      throw Mismatch("subject '" + s + "' of the baseline is not in this run (this run has: " + join(cur_subjects) +
+                     ")");
   if (base_subjects.empty())
     throw Mismatch("nothing to compare: the baseline has no cell" +
                    std::string(scope.families.empty() && scope.sweeps.empty() && scope.subjects.empty()
@@ -188,8 +192,10 @@ std::string Diff::table(const json& current) const {
   };
   std::string out;
   char head[512];
-  std::snprintf(head, sizeof head, "%zu figure(s) rose, %zu fell, in %zu cells compared (seed %llu, %lld rays per family, "
-                "rayaudit %s)\n", rose.size(), fell.size(), cells, (unsigned long long)seed, rays, version.c_str());
+  std::snprintf(head, sizeof head,
+                "%zu figure(s) rose, %zu fell, in %zu cells compared (seed %llu, %lld rays per family, "
+                "rayaudit %s)\n",
+                rose.size(), fell.size(), cells, (unsigned long long)seed, rays, version.c_str());
   out += head;
   if (!rose.empty() || !fell.empty()) {
     std::snprintf(head, sizeof head, "%-9s %-24s %-28s %-20s %12s %12s\n", "", "SUBJECT", "FAMILY@SWEEP", "MEASURE",

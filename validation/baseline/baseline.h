@@ -66,11 +66,11 @@ void check_plan(const nlohmann::json& baseline, std::uint64_t seed, long long ra
 struct FamilyResult {
   std::string subject, family;
   std::uint64_t tests = 0;
-  bool failed = false;            // a wrong answer, leak, double hit or NaN answer in any sweep value
-  std::string words;              // "grazing@1e-06: 12 false misses; grazing@1e-07: 40 false misses, 2 bad t"
-  std::vector<std::string> ids;   // up to 3 failing case ids (the cells' "examples")
-  std::string replay;             // a command showing those cases with their exact verdicts
-  std::string hint;               // e.g. the subject looks one-sided; empty if nothing to say
+  bool failed = false;           // a wrong answer, leak, double hit or NaN answer in any sweep value
+  std::string words;             // "grazing@1e-06: 12 false misses; grazing@1e-07: 40 false misses, 2 bad t"
+  std::vector<std::string> ids;  // up to 3 failing case ids (the cells' "examples")
+  std::string replay;            // a command showing those cases with their exact verdicts
+  std::string hint;              // e.g. the subject looks one-sided; empty if nothing to say
 };
 
 std::vector<FamilyResult> family_results(const nlohmann::json& audit, const Scope& scope = {});

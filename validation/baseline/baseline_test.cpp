@@ -27,10 +27,8 @@ fs::path tmp(const std::string& name) {
 ra::audit::TriangleSubject registry(const char* name, bool cull = false) {
   const ra::Method* m = ra::find_method(name);
   auto k = m->tri_f.hit;
-  return ra::audit::triangle_subject<float>(
-      name, [k, cull](const ra::Rayf& r, const ra::Vec3f& a, const ra::Vec3f& b, const ra::Vec3f& c) {
-        return k(r, a, b, c, cull);
-      });
+  return ra::audit::triangle_subject<float>(name, [k, cull](const ra::Rayf& r, const ra::Vec3f& a, const ra::Vec3f& b,
+                                                            const ra::Vec3f& c) { return k(r, a, b, c, cull); });
 }
 
 // Watertight, except that rays within 2e-6 rad of the triangle's plane miss:
@@ -38,8 +36,9 @@ ra::audit::TriangleSubject registry(const char* name, bool cull = false) {
 ra::audit::TriangleSubject loses_grazing_hits() {
   const auto base = registry("watertight");
   return ra::audit::triangle_subject<float>(
-      "watertight", [base](const ra::Rayf& r, const ra::Vec3f& a, const ra::Vec3f& b, const ra::Vec3f& c)
-                        -> std::optional<ra::TriangleHit<float>> {
+      "watertight",
+      [base](const ra::Rayf& r, const ra::Vec3f& a, const ra::Vec3f& b,
+             const ra::Vec3f& c) -> std::optional<ra::TriangleHit<float>> {
         const ra::Vec3d n = normalize(cross(ra::Vec3d(b) - ra::Vec3d(a), ra::Vec3d(c) - ra::Vec3d(a)));
         const double s = std::abs(dot(n, normalize(ra::Vec3d(r.d))));
         if (s < 2e-6) return std::nullopt;
@@ -48,13 +47,19 @@ ra::audit::TriangleSubject loses_grazing_hits() {
 }
 
 json cell(const std::string& family, const std::string& sweep, std::uint64_t wrong, std::uint64_t ulps_max) {
-  return {{"subject", "m/float"}, {"family", family}, {"sweep", sweep},
-          {"stats", {{"tests", 100}, {"wrong", wrong}, {"leaks", 0}, {"double_hits", 0}, {"nan_inf", 0},
-                     {"t_ulps_max", ulps_max}}}};
+  return {
+      {"subject", "m/float"},
+      {"family", family},
+      {"sweep", sweep},
+      {"stats",
+       {{"tests", 100}, {"wrong", wrong}, {"leaks", 0}, {"double_hits", 0}, {"nan_inf", 0}, {"t_ulps_max", ulps_max}}}};
 }
 json doc(std::vector<json> cells, std::uint64_t seed = 1) {
-  return {{"seed", seed}, {"rays_per_family", 100}, {"version", RAYAUDIT_VERSION},
-          {"subjects", {{{"name", "m/float"}}}}, {"cells", cells}};
+  return {{"seed", seed},
+          {"rays_per_family", 100},
+          {"version", RAYAUDIT_VERSION},
+          {"subjects", {{{"name", "m/float"}}}},
+          {"cells", cells}};
 }
 
 TEST(Baseline, CountsRiseByOneAndMaximaOnlyPastDoubling) {
@@ -86,13 +91,13 @@ TEST(Baseline, RunsOfOtherRaysAreMismatches) {
   other_tests["cells"][0]["stats"]["tests"] = 99;
   json shard = a;
   shard["shard"] = {{"k", 1}, {"n", 2}};
-  for (const auto& [b, word] : std::vector<std::pair<json, std::string>>{
-           {doc({cell("grazing", "1e-06", 3, 3)}, 2), "seeds differ"},
-           {other_version, "0.0.1"},
-           {doc({cell("edge", "0", 3, 3)}), "families differ"},
-           {doc({cell("grazing", "1e-07", 3, 3)}), "sweep values differ"},
-           {other_tests, "not the same rays"},
-           {shard, "merge the shards first"}}) {
+  for (const auto& [b, word] :
+       std::vector<std::pair<json, std::string>>{{doc({cell("grazing", "1e-06", 3, 3)}, 2), "seeds differ"},
+                                                 {other_version, "0.0.1"},
+                                                 {doc({cell("edge", "0", 3, 3)}), "families differ"},
+                                                 {doc({cell("grazing", "1e-07", 3, 3)}), "sweep values differ"},
+                                                 {other_tests, "not the same rays"},
+                                                 {shard, "merge the shards first"}}) {
     try {
       ra::baseline::compare(a, b);
       ADD_FAILURE() << "accepted: " << word;
@@ -154,7 +159,8 @@ TEST(Baseline, OneSidedSubjectIsNamedAsSuch) {
   EXPECT_NE(m.find("cases random:"), std::string::npos) << m;
   EXPECT_NE(m.find("replay: rayaudit audit --export-cases"), std::string::npos) << m;
   // Two-sided, the same method has no such hint.
-  const ::testing::AssertionResult two = ra::audit::HasNoWrongAnswers(registry("moller"), {.families = {"random"}, .rays = 2000});
+  const ::testing::AssertionResult two =
+      ra::audit::HasNoWrongAnswers(registry("moller"), {.families = {"random"}, .rays = 2000});
   EXPECT_EQ(std::string(two.message()).find("one-sided"), std::string::npos) << two.message();
 }
 
@@ -187,9 +193,11 @@ TEST(Baseline, JUnitParsesWithNastyNames) {
                           {{"cls", "passes", Case::Status::pass, "", "", 0.5},
                            {"cls " + nasty, "fails " + nasty, Case::Status::fail, "msg " + nasty, "body\n" + nasty, 0},
                            {"cls", "skips", Case::Status::skip, "why", "", 0}}}});
-  const std::string cmd = "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
-                          "cs = list(r.iter('testcase')); print(len(cs), r.get('failures'), r.get('skipped'), "
-                          "cs[1].find('failure').get('message')[:9])\" " + out.string();
+  const std::string cmd =
+      "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1]).getroot(); "
+      "cs = list(r.iter('testcase')); print(len(cs), r.get('failures'), r.get('skipped'), "
+      "cs[1].find('failure').get('message')[:9])\" " +
+      out.string();
   FILE* p = popen(cmd.c_str(), "r");
   char buf[256] = {0};
   const std::size_t n = fread(buf, 1, sizeof buf - 1, p);

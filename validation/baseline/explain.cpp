@@ -61,12 +61,14 @@ struct Sides {
     if (back >= 8 && back_missed == back && front > 0 && front_missed * 10 < front)
       return "looks one-sided: it missed all " + std::to_string(back) +
              " hits on triangles seen from behind (d . ((b-a) x (c-a)) > 0) but only " + std::to_string(front_missed) +
-             " of " + std::to_string(front) + " from the front; the audit expects two-sided subjects (no back-face "
+             " of " + std::to_string(front) +
+             " from the front; the audit expects two-sided subjects (no back-face "
              "culling; see validation/exact/README.md, the subject contract)";
     if (front >= 8 && front_missed == front && back > 0 && back_missed * 10 < back)
       return "looks one-sided: it missed all " + std::to_string(front) +
-             " hits on triangles seen from the front (d . ((b-a) x (c-a)) < 0) but only " + std::to_string(back_missed) +
-             " of " + std::to_string(back) + " from behind; the audit expects two-sided subjects";
+             " hits on triangles seen from the front (d . ((b-a) x (c-a)) < 0) but only " +
+             std::to_string(back_missed) + " of " + std::to_string(back) +
+             " from behind; the audit expects two-sided subjects";
     return {};
   }
 };
@@ -143,8 +145,7 @@ std::vector<FamilyResult> family_results(const json& audit, const Scope& scope) 
     if (!r.failed) continue;
     r.replay = replay_command(audit, r.subject, r.family, r.ids);
     // The subject-wide pattern, shown where this family's misses are part of it.
-    if (family_sides[i].back_missed > 0)
-      r.hint = subject_sides[r.subject].hint();
+    if (family_sides[i].back_missed > 0) r.hint = subject_sides[r.subject].hint();
   }
   return out;
 }

@@ -17,10 +17,14 @@ std::size_t utf8_at(const std::string& s, std::size_t i, unsigned& cp) {
   const unsigned c = b(i);
   std::size_t n;
   if (c < 0x80) return cp = c, 1;
-  if ((c & 0xE0) == 0xC0) n = 2, cp = c & 0x1F;
-  else if ((c & 0xF0) == 0xE0) n = 3, cp = c & 0x0F;
-  else if ((c & 0xF8) == 0xF0) n = 4, cp = c & 0x07;
-  else return 0;
+  if ((c & 0xE0) == 0xC0)
+    n = 2, cp = c & 0x1F;
+  else if ((c & 0xF0) == 0xE0)
+    n = 3, cp = c & 0x0F;
+  else if ((c & 0xF8) == 0xF0)
+    n = 4, cp = c & 0x07;
+  else
+    return 0;
   if (i + n > s.size()) return 0;
   for (std::size_t k = 1; k < n; ++k) {
     if ((b(i + k) & 0xC0) != 0x80) return 0;
@@ -52,19 +56,37 @@ std::string escape(const std::string& s, bool attribute) {
       continue;
     }
     switch (cp) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
       // Attribute values would have these normalised to spaces: kept as references.
-      case '\t': out += attribute ? "&#9;" : "\t"; break;
-      case '\n': out += attribute ? "&#10;" : "\n"; break;
-      case '\r': out += "&#13;"; break;
+      case '\t':
+        out += attribute ? "&#9;" : "\t";
+        break;
+      case '\n':
+        out += attribute ? "&#10;" : "\n";
+        break;
+      case '\r':
+        out += "&#13;";
+        break;
       default:
         // XML 1.0 has no C0 controls but tab and line ends, and no U+FFFE/FFFF.
-        if (cp < 0x20 || cp == 0xFFFE || cp == 0xFFFF) out += "\xEF\xBF\xBD";
-        else out.append(s, i, n);
+        if (cp < 0x20 || cp == 0xFFFE || cp == 0xFFFF)
+          out += "\xEF\xBF\xBD";
+        else
+          out.append(s, i, n);
     }
     i += n;
   }
@@ -87,9 +109,11 @@ std::string to_xml(const std::vector<Suite>& suites) {
   for (const Suite& su : suites) {
     std::size_t f = 0, sk = 0;
     double t = 0;
-    for (const Case& c : su.cases) f += c.status == Case::Status::fail, sk += c.status == Case::Status::skip, t += c.seconds;
+    for (const Case& c : su.cases)
+      f += c.status == Case::Status::fail, sk += c.status == Case::Status::skip, t += c.seconds;
     x += " <testsuite name=\"" + escape(su.name) + "\" tests=\"" + std::to_string(su.cases.size()) + "\" failures=\"" +
-         std::to_string(f) + "\" errors=\"0\" skipped=\"" + std::to_string(sk) + "\" time=\"" + format_seconds(t) + "\">\n";
+         std::to_string(f) + "\" errors=\"0\" skipped=\"" + std::to_string(sk) + "\" time=\"" + format_seconds(t) +
+         "\">\n";
     for (const Case& c : su.cases) {
       x += "  <testcase classname=\"" + escape(c.classname) + "\" name=\"" + escape(c.name) + "\" time=\"" +
            format_seconds(c.seconds) + "\"";
@@ -100,8 +124,10 @@ std::string to_xml(const std::vector<Suite>& suites) {
       const char* tag = c.status == Case::Status::fail ? "failure" : "skipped";
       x += ">\n   <" + std::string(tag) + " message=\"" + escape(c.message) + "\"";
       if (c.status == Case::Status::fail) x += " type=\"failure\"";
-      if (c.text.empty()) x += "/>\n";
-      else x += ">" + escape(c.text, false) + "</" + tag + ">\n";
+      if (c.text.empty())
+        x += "/>\n";
+      else
+        x += ">" + escape(c.text, false) + "</" + tag + ">\n";
       x += "  </testcase>\n";
     }
     x += " </testsuite>\n";

@@ -19,8 +19,8 @@ struct Case {
   std::string classname;  // e.g. "audit.moller/float", "golden"
   std::string name;       // e.g. "grazing", a scene's name
   enum class Status { pass, fail, skip } status = Status::pass;
-  std::string message;    // one line: the failure or skip reason
-  std::string text;       // the body: the table's rows, ids, the replay command
+  std::string message;  // one line: the failure or skip reason
+  std::string text;     // the body: the table's rows, ids, the replay command
   double seconds = 0;
 };
 

@@ -60,13 +60,15 @@ std::optional<CasesStamp> read_stamp(const std::string& path) {
     } else if (key == "families" && !value.empty()) {
       for (const auto& f : split_fields(value, ',')) {
         if (!find_family(f))
-          throw InputError(located(path, 1, "the stamp names family '" + f + "', which is not a family (" +
-                                                family_names() + ")"));
+          throw InputError(
+              located(path, 1, "the stamp names family '" + f + "', which is not a family (" + family_names() + ")"));
         s.families.push_back(f);
       }
     } else {
-      throw InputError(located(path, 1, "the stamp's '" + w + "' is not version=, seed=, rays=, precision=float|double "
-                                        "or families="));
+      throw InputError(located(path, 1,
+                               "the stamp's '" + w +
+                                   "' is not version=, seed=, rays=, precision=float|double "
+                                   "or families="));
     }
   }
   if (s.version.empty() || !seen_seed || !seen_rays || s.precision.empty() || s.families.empty())

@@ -44,7 +44,8 @@ std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 // The asan preset's libraries call the sanitizers' runtime: the consumer is
 // then compiled and linked with the same flags, as a user of such a build would.
 #ifdef RAYAUDIT_CONSUMER_FLAGS
-const std::string kConsumerFlags = " -DCMAKE_CXX_FLAGS='" RAYAUDIT_CONSUMER_FLAGS "' -DCMAKE_EXE_LINKER_FLAGS='" RAYAUDIT_CONSUMER_FLAGS "'";
+const std::string kConsumerFlags =
+    " -DCMAKE_CXX_FLAGS='" RAYAUDIT_CONSUMER_FLAGS "' -DCMAKE_EXE_LINKER_FLAGS='" RAYAUDIT_CONSUMER_FLAGS "'";
 #else
 const std::string kConsumerFlags;
 #endif
@@ -83,9 +84,9 @@ TEST_F(PackageConsumer, InstalledPackageBuildsAUsersProjectAndItsTestReportsTheL
   ASSERT_EQ(render.code, 0) << render.out;
   EXPECT_GT(fs::file_size(png), 50u);
 
-  const ShellResult configure = sh(cmake + " -S " + quoted(fs::path(RAYAUDIT_SOURCE_DIR) / "validation/consumer") +
-                           " -B " + quoted(build) + " -G Ninja -DCMAKE_BUILD_TYPE=Release" +
-                           " -DCMAKE_PREFIX_PATH=" + quoted(prefix) + kConsumerFlags);
+  const ShellResult configure =
+      sh(cmake + " -S " + quoted(fs::path(RAYAUDIT_SOURCE_DIR) / "validation/consumer") + " -B " + quoted(build) +
+         " -G Ninja -DCMAKE_BUILD_TYPE=Release" + " -DCMAKE_PREFIX_PATH=" + quoted(prefix) + kConsumerFlags);
   ASSERT_EQ(configure.code, 0) << configure.out;
   const ShellResult compile = sh(cmake + " --build " + quoted(build));
   ASSERT_EQ(compile.code, 0) << compile.out;
@@ -107,8 +108,9 @@ TEST_F(PackageConsumer, InstalledPackageBuildsAUsersProjectAndItsTestReportsTheL
   const std::string message = expected.message();
   EXPECT_NE(message.find("textbook-moller/"), std::string::npos) << message;
   EXPECT_NE(message.find(" leaked "), std::string::npos) << message;
-  EXPECT_NE(test.out.find(message), std::string::npos)
-      << "installed consumer said:\n" << test.out << "\nthe build tree says:\n" << message;
+  EXPECT_NE(test.out.find(message), std::string::npos) << "installed consumer said:\n"
+                                                       << test.out << "\nthe build tree says:\n"
+                                                       << message;
 }
 
 }  // namespace

@@ -14,7 +14,7 @@ namespace my {
 // right on its own, but two triangles sharing an edge each round the edge's
 // test their own way, so some rays pass between them.
 inline std::optional<ra::TriangleHit<float>> textbook_moller(const ra::Rayf& r, const ra::Vec3f& v0,
-                                                              const ra::Vec3f& v1, const ra::Vec3f& v2) {
+                                                             const ra::Vec3f& v1, const ra::Vec3f& v2) {
   constexpr float kEpsilon = 1e-6f;
   const ra::Vec3f e1 = v1 - v0, e2 = v2 - v0;
   const ra::Vec3f p = cross(r.d, e2);

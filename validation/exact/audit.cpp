@@ -24,12 +24,12 @@ namespace ra::audit {
 TriangleSubject registry_triangle(const Method& m, Precision p) {
   if (p == Precision::f32) {
     auto k = m.tri_f.hit;
-    return triangle_subject<float>(m.name, [k](const Rayf& r, const Vec3f& a, const Vec3f& b,
-                                               const Vec3f& c) { return k(r, a, b, c, false); });
+    return triangle_subject<float>(
+        m.name, [k](const Rayf& r, const Vec3f& a, const Vec3f& b, const Vec3f& c) { return k(r, a, b, c, false); });
   }
   auto k = m.tri_d.hit;
-  return triangle_subject<double>(m.name, [k](const Rayd& r, const Vec3d& a, const Vec3d& b,
-                                              const Vec3d& c) { return k(r, a, b, c, false); });
+  return triangle_subject<double>(
+      m.name, [k](const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) { return k(r, a, b, c, false); });
 }
 
 SphereSubject registry_sphere(const Method& m, Precision p) {
@@ -45,7 +45,8 @@ SphereSubject registry_sphere(const Method& m, Precision p) {
 namespace {
 
 // Distance in representable values of T between x and y (saturating).
-template <class T> std::uint64_t ulp_distance(T x, T y) {
+template <class T>
+std::uint64_t ulp_distance(T x, T y) {
   using I = std::conditional_t<sizeof(T) == 4, std::int32_t, std::int64_t>;
   I ix, iy;
   std::memcpy(&ix, &x, sizeof x);
@@ -60,8 +61,8 @@ template <class T> std::uint64_t ulp_distance(T x, T y) {
 
 int ulp_bin(std::uint64_t v) {
   if (v < 64) return int(v);
-  const int e = 63 - __builtin_clzll(v);                       // >= 6
-  const int sub = int((v >> (e - 2)) & 3);                     // next two bits
+  const int e = 63 - __builtin_clzll(v);    // >= 6
+  const int sub = int((v >> (e - 2)) & 3);  // next two bits
   return std::min(Stats::kUlpBins - 1, 64 + (e - 6) * 4 + sub);
 }
 std::uint64_t ulp_bin_low(int bin) {
@@ -78,7 +79,8 @@ int rel_bin(double r) {
 }
 double rel_bin_low(int bin) { return bin == 0 ? 0 : std::exp2(Stats::kRelMinExp + (bin - 1) / 8.0); }
 
-template <std::size_t N> int median_bin(const std::array<std::uint64_t, N>& h, std::uint64_t n) {
+template <std::size_t N>
+int median_bin(const std::array<std::uint64_t, N>& h, std::uint64_t n) {
   std::uint64_t acc = 0;
   for (std::size_t i = 0; i < N; ++i)
     if ((acc += h[i]) * 2 >= n) return int(i);
@@ -118,9 +120,7 @@ void Stats::note_example(std::uint64_t probe) {
   if (examples.size() > kExamples) examples.pop_back();
 }
 
-std::uint64_t Stats::median_ulps() const {
-  return t_samples ? ulp_bin_low(median_bin(ulp_hist, t_samples)) : 0;
-}
+std::uint64_t Stats::median_ulps() const { return t_samples ? ulp_bin_low(median_bin(ulp_hist, t_samples)) : 0; }
 double Stats::median_rel() const { return t_samples ? rel_bin_low(median_bin(rel_hist, t_samples)) : 0; }
 
 // At most 1: a hit at NaN t is both wrong and NaN, so the sum can pass the
@@ -176,11 +176,33 @@ namespace {
 // invariants are those book() keeps: each test counted under exactly one
 // verdict, and every part no larger than its whole.
 void check_merged_stats(const nlohmann::json& j, const nlohmann::json& h, const Stats& s) {
-  static const std::set<std::string> stats_keys = {
-      "tests", "wrong", "wrong_pct", "true_hits", "false_hits", "true_misses", "false_misses", "boundary_hits",
-      "boundary_misses", "coplanar_hits", "coplanar_misses", "degenerate_hits", "degenerate_misses", "nan_inf",
-      "wrong_t", "groups", "leaks", "double_hits", "spawned", "self_hits", "t_samples", "t_ulps_median",
-      "t_ulps_max", "t_rel_median", "t_rel_max", "back_hits", "back_false_misses"};
+  static const std::set<std::string> stats_keys = {"tests",
+                                                   "wrong",
+                                                   "wrong_pct",
+                                                   "true_hits",
+                                                   "false_hits",
+                                                   "true_misses",
+                                                   "false_misses",
+                                                   "boundary_hits",
+                                                   "boundary_misses",
+                                                   "coplanar_hits",
+                                                   "coplanar_misses",
+                                                   "degenerate_hits",
+                                                   "degenerate_misses",
+                                                   "nan_inf",
+                                                   "wrong_t",
+                                                   "groups",
+                                                   "leaks",
+                                                   "double_hits",
+                                                   "spawned",
+                                                   "self_hits",
+                                                   "t_samples",
+                                                   "t_ulps_median",
+                                                   "t_ulps_max",
+                                                   "t_rel_median",
+                                                   "t_rel_max",
+                                                   "back_hits",
+                                                   "back_false_misses"};
   for (const auto& [key, value] : j.items())
     if (!stats_keys.count(key)) throw std::runtime_error("stats: '" + key + "': unknown key");
   for (const auto& [key, value] : h.items())
@@ -267,10 +289,14 @@ Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
 // -------------------------------------------------------- evaluation ---
 namespace {
 
-template <class T> bool finite_hit(const TriangleHit<T>& h) {
+template <class T>
+bool finite_hit(const TriangleHit<T>& h) {
   return std::isfinite(h.t) && std::isfinite(h.b1) && std::isfinite(h.b2);
 }
-template <class T> bool finite_hit(const SurfaceHit<T>& h) { return std::isfinite(h.t); }
+template <class T>
+bool finite_hit(const SurfaceHit<T>& h) {
+  return std::isfinite(h.t);
+}
 
 // Books one test: the exact answer against the subject's (hit, t).
 template <class T>
@@ -279,11 +305,21 @@ void book(Stats& s, const oracle::Answer& a, bool hit, bool finite, T t) {
   ++s.tests;
   if (hit && !finite) ++s.nan_inf;
   switch (a.verdict) {
-    case Verdict::hit: ++(hit ? s.true_hits : s.false_misses); break;
-    case Verdict::miss: ++(hit ? s.false_hits : s.true_misses); break;
-    case Verdict::boundary: ++(hit ? s.boundary_hits : s.boundary_misses); break;
-    case Verdict::coplanar: ++(hit ? s.coplanar_hits : s.coplanar_misses); break;
-    case Verdict::degenerate: ++(hit ? s.degenerate_hits : s.degenerate_misses); break;
+    case Verdict::hit:
+      ++(hit ? s.true_hits : s.false_misses);
+      break;
+    case Verdict::miss:
+      ++(hit ? s.false_hits : s.true_misses);
+      break;
+    case Verdict::boundary:
+      ++(hit ? s.boundary_hits : s.boundary_misses);
+      break;
+    case Verdict::coplanar:
+      ++(hit ? s.coplanar_hits : s.coplanar_misses);
+      break;
+    case Verdict::degenerate:
+      ++(hit ? s.degenerate_hits : s.degenerate_misses);
+      break;
   }
   if (!hit || !(a.verdict == Verdict::hit || a.verdict == Verdict::boundary)) return;
   // A hit at t = NaN or +-inf is off by more than any bound: wrong, and no
@@ -300,19 +336,33 @@ void book(Stats& s, const oracle::Answer& a, bool hit, bool finite, T t) {
   ++s.ulp_hist[std::size_t(ulp_bin(ulps))];
   ++s.rel_hist[std::size_t(rel_bin(rel))];
   // The far root: the roots are told apart only when they differ in T.
-  const bool far_root = std::isfinite(a.t_far) && T(a.t_far) != T(a.t) &&
-                        std::abs(double(t) - a.t_far) < std::abs(double(t) - a.t);
+  const bool far_root =
+      std::isfinite(a.t_far) && T(a.t_far) != T(a.t) && std::abs(double(t) - a.t_far) < std::abs(double(t) - a.t);
   if (rel > kWrongTRelative || far_root) ++s.wrong_t;
 }
 
-template <class T> Vec3<T> cv(const Vec3d& v) { return Vec3<T>(v); }
-template <class T> Ray<T> cr(const Rayd& r) { return Ray<T>(r); }
-
-template <class T> const TriangleFn<T>& fn(const TriangleSubject& s) {
-  if constexpr (sizeof(T) == 4) return s.f32; else return s.f64;
+template <class T>
+Vec3<T> cv(const Vec3d& v) {
+  return Vec3<T>(v);
 }
-template <class T> const SphereFn<T>& fn(const SphereSubject& s) {
-  if constexpr (sizeof(T) == 4) return s.f32; else return s.f64;
+template <class T>
+Ray<T> cr(const Rayd& r) {
+  return Ray<T>(r);
+}
+
+template <class T>
+const TriangleFn<T>& fn(const TriangleSubject& s) {
+  if constexpr (sizeof(T) == 4)
+    return s.f32;
+  else
+    return s.f64;
+}
+template <class T>
+const SphereFn<T>& fn(const SphereSubject& s) {
+  if constexpr (sizeof(T) == 4)
+    return s.f32;
+  else
+    return s.f64;
 }
 
 // Number of distinct exact crossings of a group ahead of the origin
@@ -376,9 +426,8 @@ struct ProbeNumbers {
 };
 
 template <class T>
-void eval_probes(const TriangleSubject& s, const TriangleBatch& b,
-                 const std::vector<oracle::Answer>& ans, const std::vector<int>& cross,
-                 const std::vector<char>& proper, Stats& st, ProbeNumbers number) {
+void eval_probes(const TriangleSubject& s, const TriangleBatch& b, const std::vector<oracle::Answer>& ans,
+                 const std::vector<int>& cross, const std::vector<char>& proper, Stats& st, ProbeNumbers number) {
   const auto& f = fn<T>(s);
   std::size_t pair = 0;  // index into ans, see judge()
   for (std::size_t pi = 0; pi < b.probes.size(); ++pi) {
@@ -410,7 +459,9 @@ void eval_secondary(const TriangleSubject& s, SelfIntersection strategy, const T
     struct Note {  // at every exit of this probe's body
       Stats& st;
       std::uint64_t bad, n;
-      ~Note() { if (st.bad() != bad) st.note_example(n); }
+      ~Note() {
+        if (st.bad() != bad) st.note_example(n);
+      }
     } note{st, bad, number(pi)};
     const Tri& tri = b.tris[std::size_t(p.first)];
     const Vec3<T> A = cv<T>(tri.a), B = cv<T>(tri.b), C = cv<T>(tri.c);
@@ -437,8 +488,8 @@ void eval_secondary(const TriangleSubject& s, SelfIntersection strategy, const T
 }
 
 template <class T>
-void eval_spheres(const SphereSubject& s, const std::vector<SphereCase>& cs,
-                  const std::vector<oracle::Answer>& ans, Stats& st, ProbeNumbers number) {
+void eval_spheres(const SphereSubject& s, const std::vector<SphereCase>& cs, const std::vector<oracle::Answer>& ans,
+                  Stats& st, ProbeNumbers number) {
   const auto& f = fn<T>(s);
   for (std::size_t i = 0; i < cs.size(); ++i) {
     const std::uint64_t bad = st.bad();
@@ -458,10 +509,10 @@ struct SweepPlan {
   const Family* family;
   std::size_t fam_index;
   int sweep;
-  long long probes;           // of the unsharded run
-  std::uint64_t first_task;   // tasks of earlier sweep values (this shard's)
-  std::uint64_t tasks;        // this shard's chunks of this sweep value
-  std::uint64_t per_probe;    // tests per probe, as --rays counts them
+  long long probes;          // of the unsharded run
+  std::uint64_t first_task;  // tasks of earlier sweep values (this shard's)
+  std::uint64_t tasks;       // this shard's chunks of this sweep value
+  std::uint64_t per_probe;   // tests per probe, as --rays counts them
   // Sharded, a sweep value of fewer than 4 n chunks is split by probe (every
   // shard generates each chunk and keeps probes j with j % n == k - 1), so
   // small runs split evenly too; larger ones are dealt whole chunks, so no
@@ -495,7 +546,8 @@ struct Plan {
 };
 
 // The probes of chunk c (global index c * kChunk + i) dealt to this shard.
-template <class V> V keep_dealt(const V& all, std::uint64_t c, Shard s) {
+template <class V>
+V keep_dealt(const V& all, std::uint64_t c, Shard s) {
   V out;
   for (std::size_t i = 0; i < all.size(); ++i)
     if ((c * kChunk + i) % s.n == s.k - 1) out.push_back(all[i]);
@@ -512,8 +564,9 @@ Plan plan(const std::vector<const Family*>& fams, long long rays, Shard shard) {
   for (std::size_t fi = 0; fi < fams.size(); ++fi) {
     const Family& f = *fams[fi];
     for (int s = 0; s < int(f.sweep.size()); ++s) {
-      SweepPlan sp{&f, fi, s, probes_per_sweep(f, s, rays), pl.tasks, 0,
-                   std::uint64_t(f.secondary ? 2 : f.tris_per_probe(s)), false};
+      SweepPlan sp{
+          &f,   fi, s, probes_per_sweep(f, s, rays), pl.tasks, 0, std::uint64_t(f.secondary ? 2 : f.tris_per_probe(s)),
+          false};
       const auto chunks = std::uint64_t((sp.probes + kChunk - 1) / kChunk);
       sp.by_probe = shard.n > 1 && chunks < 4 * shard.n;
       std::uint64_t probes;
@@ -549,8 +602,8 @@ std::vector<oracle::Answer> judge(const TriangleBatch& b) {
 
 }  // namespace
 
-void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given,
-                 int count, bool closed) {
+void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given, int count,
+                 bool closed) {
   // Float answers are judged on the inputs rounded to float, as the audit's
   // own float cases are (a no-op for cases exported in float).
   const bool f32 = p == Precision::f32;
@@ -561,7 +614,8 @@ void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const
   for (Tri& t : in) t = {in_p(t.a), in_p(t.b), in_p(t.c)};
   std::vector<oracle::Answer> ans;
   ans.reserve(std::size_t(count));
-  for (int k = 0; k < count; ++k) ans.push_back(oracle::triangle(r, in[std::size_t(k)].a, in[std::size_t(k)].b, in[std::size_t(k)].c));
+  for (int k = 0; k < count; ++k)
+    ans.push_back(oracle::triangle(r, in[std::size_t(k)].a, in[std::size_t(k)].b, in[std::size_t(k)].c));
   GroupHits group;
   for (int k = 0; k < count; ++k) {
     const GivenAnswer& g = given[k];
@@ -587,7 +641,8 @@ void for_each_probe_case(const Family& f, int sweep, Precision p, std::uint64_t 
   const long long n = probes_per_sweep(f, sweep, rays);
   for (long long c = 0; c * kChunk < n; ++c) {
     TriangleBatch b;
-    generate(f, sweep, p, stream_seed(seed, f.name, sweep, std::uint64_t(c)), int(std::min<long long>(kChunk, n - c * kChunk)), b);
+    generate(f, sweep, p, stream_seed(seed, f.name, sweep, std::uint64_t(c)),
+             int(std::min<long long>(kChunk, n - c * kChunk)), b);
     for (const Probe& pr : b.probes) {
       ProbeCase pc{pr.ray, {}, {}};
       for (int k = pr.first; k < pr.first + pr.count; ++k) {
@@ -600,15 +655,13 @@ void for_each_probe_case(const Family& f, int sweep, Precision p, std::uint64_t 
   }
 }
 
-std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
-                                   long long rays) {
+std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays) {
   std::vector<ProbeCase> out;
   for_each_probe_case(f, sweep, p, seed, rays, [&](const ProbeCase& pc) { out.push_back(pc); });
   return out;
 }
 
-std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
-                                     long long rays) {
+std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays) {
   std::vector<SphereCase> out;
   const long long n = probes_per_sweep(f, sweep, rays);
   for (long long c = 0; c * kChunk < n; ++c)
@@ -617,8 +670,7 @@ std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, st
   return out;
 }
 
-Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres,
-           const Options& opt) {
+Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres, const Options& opt) {
   // The CLI checks these with its own messages; the library's users (the
   // GoogleTest checks) get the same refusals.
   for (const std::string& name : opt.families) {
@@ -630,11 +682,13 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
     }
     if (f->kind == Kind::triangle ? tris.empty() : spheres.empty())
       throw std::invalid_argument("audit: family '" + name + "' grades " +
-                                  (f->kind == Kind::triangle ? "triangles" : "spheres") + ", and no such subject is given");
+                                  (f->kind == Kind::triangle ? "triangles" : "spheres") +
+                                  ", and no such subject is given");
   }
   if (opt.rays < 1 || opt.rays > 10000000000LL)
     throw std::invalid_argument("audit: rays must be 1 to 1e10 per family, got " + std::to_string(opt.rays));
-  if (opt.threads < 0) throw std::invalid_argument("audit: threads must be 0 (all) or more, got " + std::to_string(opt.threads));
+  if (opt.threads < 0)
+    throw std::invalid_argument("audit: threads must be 0 (all) or more, got " + std::to_string(opt.threads));
   Report rep;
   rep.seed = opt.seed;
   rep.rays = opt.rays;
@@ -645,8 +699,8 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
 
   std::vector<const Family*> fams;
   for (const Family& f : families()) {
-    const bool wanted = opt.families.empty() ||
-                        std::find(opt.families.begin(), opt.families.end(), f.name) != opt.families.end();
+    const bool wanted =
+        opt.families.empty() || std::find(opt.families.begin(), opt.families.end(), f.name) != opt.families.end();
     const bool has_subjects = f.kind == Kind::triangle ? !tris.empty() : !spheres.empty();
     if (wanted && has_subjects) fams.push_back(&f);
   }
@@ -715,7 +769,8 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
             std::size_t pair = 0;
             for (const Probe& pr : b.probes) {
               cross.push_back(crossings(&ans[pair], pr.count));
-              proper.push_back(pr.closed || (pr.count > 1 && group_is_proper(&b.tris[std::size_t(pr.first)], pr.count, pr.ray.d)));
+              proper.push_back(pr.closed ||
+                               (pr.count > 1 && group_is_proper(&b.tris[std::size_t(pr.first)], pr.count, pr.ray.d)));
               pair += std::size_t(pr.count);
             }
           }
@@ -773,8 +828,7 @@ Stats Report::total(std::size_t subject) const {
 const Cell* Report::worst(std::size_t subject) const {
   const Cell* w = nullptr;
   for (const Cell& c : cells)
-    if (c.subject == subject && c.stats.badness() > 0 && (!w || c.stats.badness() > w->stats.badness()))
-      w = &c;
+    if (c.subject == subject && c.stats.badness() > 0 && (!w || c.stats.badness() > w->stats.badness())) w = &c;
   return w;
 }
 
@@ -810,17 +864,18 @@ nlohmann::json Report::to_json() const {
     }
     if (shard) cs.back()["histograms"] = c.stats.histograms_json();
   }
-  nlohmann::json out = {{"seed", seed},
-          {"version", RAYAUDIT_VERSION},
-          {"rays_per_family", rays},
-          {"semantics",
-           "ray = {o + t d : max(tmin,0) <= t <= tmax}; closed triangle; inputs exact as given "
-           "(float cases rounded to float before method and oracle); wrong = false hits + false "
-           "misses + hits with relative t error > 1e-2, t NaN or infinite, or (spheres) nearer the far root than "
-           "the near one, t judged on hit and boundary cases; hitting or missing a boundary/coplanar/degenerate "
-           "case is counted apart, never wrong"},
-          {"subjects", subs},
-          {"cells", cs}};
+  nlohmann::json out = {
+      {"seed", seed},
+      {"version", RAYAUDIT_VERSION},
+      {"rays_per_family", rays},
+      {"semantics",
+       "ray = {o + t d : max(tmin,0) <= t <= tmax}; closed triangle; inputs exact as given "
+       "(float cases rounded to float before method and oracle); wrong = false hits + false "
+       "misses + hits with relative t error > 1e-2, t NaN or infinite, or (spheres) nearer the far root than "
+       "the near one, t judged on hit and boundary cases; hitting or missing a boundary/coplanar/degenerate "
+       "case is counted apart, never wrong"},
+      {"subjects", subs},
+      {"cells", cs}};
   if (shard) out["shard"] = {{"k", shard->k}, {"n", shard->n}};
   return out;
 }
@@ -874,10 +929,12 @@ Report Report::from_json(const nlohmann::json& j) {
     // Failing case ids: FAMILY:SWEEP:PROBE back to probe numbers (so shards
     // merge them), any other id kept as written.
     if (c.contains("examples")) {
-      if (!c["examples"].is_array()) throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "].examples: not an array");
+      if (!c["examples"].is_array())
+        throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "].examples: not an array");
       const std::string prefix = cell.family + ":" + cell.sweep_label + ":";
       for (const auto& e : c["examples"]) {
-        if (!e.is_string()) throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "].examples: not strings");
+        if (!e.is_string())
+          throw std::runtime_error("cells[" + std::to_string(r.cells.size()) + "].examples: not strings");
         const std::string id = e.get<std::string>();
         const std::string n = id.rfind(prefix, 0) == 0 ? id.substr(prefix.size()) : "";
         if (!n.empty() && n.size() < 20 && n.find_first_not_of("0123456789") == std::string::npos)
@@ -905,9 +962,9 @@ std::string count(std::uint64_t v) { return v ? std::to_string(v) : "-"; }
 }  // namespace
 
 std::string Report::summary_table() const {
-  std::string out = fmt("%-24s %10s %8s %8s %8s %7s %7s %7s %5s %7s %12s  %s\n", "METHOD/PRECISION",
-                        "TESTS", "WRONG%", "F.HITS", "F.MISS", "BAD-T", "LEAKS", "DOUBLE", "NaN",
-                        "SELF%", "T-ULPS md/max", "WORST (family@sweep: bad%)");
+  std::string out =
+      fmt("%-24s %10s %8s %8s %8s %7s %7s %7s %5s %7s %12s  %s\n", "METHOD/PRECISION", "TESTS", "WRONG%", "F.HITS",
+          "F.MISS", "BAD-T", "LEAKS", "DOUBLE", "NaN", "SELF%", "T-ULPS md/max", "WORST (family@sweep: bad%)");
   for (std::size_t i = 0; i < subjects.size(); ++i) {
     const Stats s = total(i);
     const Cell* w = worst(i);
@@ -915,17 +972,17 @@ std::string Report::summary_table() const {
                                          s.max_ulps > 99999999 ? fmt("%.1e", double(s.max_ulps)).c_str()
                                                                : std::to_string(s.max_ulps).c_str())
                                    : "-";
-    out += fmt("%-24s %10llu %8.4f %8s %8s %7s %7s %7s %5s %7s %12s  %s\n", subjects[i].c_str(),
-               (unsigned long long)s.tests, s.tests ? 100.0 * double(s.wrong()) / double(s.tests) : 0.0,
-               count(s.false_hits).c_str(), count(s.false_misses).c_str(), count(s.wrong_t).c_str(),
-               count(s.leaks).c_str(), count(s.double_hits).c_str(), count(s.nan_inf).c_str(),
-               s.spawned ? fmt("%.2f", 100.0 * double(s.self_hits) / double(s.spawned)).c_str() : "-",
-               ulps.c_str(),
-               w ? fmt("%s@%s: %.3g%%", w->family.c_str(), w->sweep_label.c_str(), 100 * w->stats.badness()).c_str()
-                 : "none");
+    out += fmt(
+        "%-24s %10llu %8.4f %8s %8s %7s %7s %7s %5s %7s %12s  %s\n", subjects[i].c_str(), (unsigned long long)s.tests,
+        s.tests ? 100.0 * double(s.wrong()) / double(s.tests) : 0.0, count(s.false_hits).c_str(),
+        count(s.false_misses).c_str(), count(s.wrong_t).c_str(), count(s.leaks).c_str(), count(s.double_hits).c_str(),
+        count(s.nan_inf).c_str(),
+        s.spawned ? fmt("%.2f", 100.0 * double(s.self_hits) / double(s.spawned)).c_str() : "-", ulps.c_str(),
+        w ? fmt("%s@%s: %.3g%%", w->family.c_str(), w->sweep_label.c_str(), 100 * w->stats.badness()).c_str() : "none");
   }
   out +=
-      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = a hit on a hit or boundary case with t off by > 1%, "
+      "WRONG% = (false hits + false misses + BAD-T) / tests; BAD-T = a hit on a hit or boundary case with t off by > "
+      "1%, "
       "NaN or infinite, or nearer a sphere's far root;\n"
       "LEAKS = edge/vertex/mesh rays the exact answer hits and the method misses entirely; "
       "DOUBLE = more hits than exact crossings; SELF% = spawned secondary rays re-hitting their triangle;\n"

@@ -25,8 +25,8 @@
 namespace ra::audit {
 
 template <class T>
-using TriangleFn = std::function<std::optional<TriangleHit<T>>(const Ray<T>&, const Vec3<T>&,
-                                                               const Vec3<T>&, const Vec3<T>&)>;
+using TriangleFn =
+    std::function<std::optional<TriangleHit<T>>(const Ray<T>&, const Vec3<T>&, const Vec3<T>&, const Vec3<T>&)>;
 template <class T>
 using SphereFn = std::function<std::optional<SurfaceHit<T>>(const Ray<T>&, const Vec3<T>&, T)>;
 
@@ -59,16 +59,20 @@ template <class T, class F>
 TriangleSubject triangle_subject(std::string method, F&& f) {
   TriangleSubject s;
   s.method = std::move(method);
-  if constexpr (sizeof(T) == sizeof(float)) s.precision = Precision::f32, s.f32 = std::forward<F>(f);
-  else s.precision = Precision::f64, s.f64 = std::forward<F>(f);
+  if constexpr (sizeof(T) == sizeof(float))
+    s.precision = Precision::f32, s.f32 = std::forward<F>(f);
+  else
+    s.precision = Precision::f64, s.f64 = std::forward<F>(f);
   return s;
 }
 template <class T, class F>
 SphereSubject sphere_subject(std::string method, F&& f) {
   SphereSubject s;
   s.method = std::move(method);
-  if constexpr (sizeof(T) == sizeof(float)) s.precision = Precision::f32, s.f32 = std::forward<F>(f);
-  else s.precision = Precision::f64, s.f64 = std::forward<F>(f);
+  if constexpr (sizeof(T) == sizeof(float))
+    s.precision = Precision::f32, s.f32 = std::forward<F>(f);
+  else
+    s.precision = Precision::f64, s.f64 = std::forward<F>(f);
   return s;
 }
 
@@ -83,9 +87,8 @@ inline constexpr double kWrongTRelative = 1e-2;
 // Counts for one subject over a set of cases.
 struct Stats {
   // Per ray/primitive test, by exact verdict and the subject's answer.
-  std::uint64_t tests = 0, true_hits = 0, false_hits = 0, true_misses = 0, false_misses = 0,
-                boundary_hits = 0, boundary_misses = 0, coplanar_hits = 0, coplanar_misses = 0,
-                degenerate_hits = 0, degenerate_misses = 0;
+  std::uint64_t tests = 0, true_hits = 0, false_hits = 0, true_misses = 0, false_misses = 0, boundary_hits = 0,
+                boundary_misses = 0, coplanar_hits = 0, coplanar_misses = 0, degenerate_hits = 0, degenerate_misses = 0;
   std::uint64_t nan_inf = 0;  // a reported hit with a NaN or infinite t, b1 or b2
   // A right hit whose t is off by more than kWrongTRelative, or (spheres, both
   // roots in the window and distinct in the subject's precision) whose t is
@@ -150,8 +153,8 @@ struct Options {
   std::vector<std::string> families;  // empty: every family of the subjects' kinds
   long long rays = 20000;             // ray/primitive tests per family per subject
   std::uint64_t seed = 1;
-  int threads = 0;                    // 0: all hardware threads
-  std::optional<Shard> shard;         // unset: every ray
+  int threads = 0;             // 0: all hardware threads
+  std::optional<Shard> shard;  // unset: every ray
   // Called after each chunk (from any thread, serialised) with the cases done
   // and planned, counted as --rays counts them (ray/primitive tests per family).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
@@ -171,12 +174,12 @@ struct Cell {
 struct Report {
   std::uint64_t seed = 0;
   long long rays = 0;
-  std::vector<std::string> subjects;  // "method/precision", triangles then spheres
-  std::vector<std::string> kinds;     // "triangle" / "sphere", per subject
+  std::vector<std::string> subjects;           // "method/precision", triangles then spheres
+  std::vector<std::string> kinds;              // "triangle" / "sphere", per subject
   std::vector<std::optional<PeerInfo>> peers;  // per subject (or empty: none is a peer)
-  std::vector<Cell> cells;            // subject-major, families and sweeps in order
-  std::optional<Shard> shard;         // set: a shard's partial counts (to_json adds
-                                      // "shard" and per-cell "histograms" for merging)
+  std::vector<Cell> cells;                     // subject-major, families and sweeps in order
+  std::optional<Shard> shard;                  // set: a shard's partial counts (to_json adds
+                                               // "shard" and per-cell "histograms" for merging)
 
   Stats total(std::size_t subject) const;
   const PeerInfo* peer(std::size_t subject) const {
@@ -196,8 +199,7 @@ struct Report {
 // Throws std::invalid_argument for a family name that is not a family
 // (a typo judged nothing, and a check on nothing passed), a named family
 // no subject's kind grades, rays outside 1..1e10 or threads below 0.
-Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres,
-           const Options& opt);
+Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSubject>& spheres, const Options& opt);
 
 // Grading answers computed elsewhere (`rayaudit audit --grade`): one probe is
 // a ray against `count` triangles (a group when count > 1: edge pair, vertex
@@ -208,8 +210,8 @@ struct GivenAnswer {
   bool hit = false;
   double t = 0, u = 0, v = 0;  // u, v: barycentrics if given (only checked for NaN/inf)
 };
-void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given,
-                 int count, bool closed);
+void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given, int count,
+                 bool closed);
 
 // Every probe of a family with its exact answers, as the audit sees them
 // (for the export and for tests that check the families themselves).
@@ -222,10 +224,8 @@ struct ProbeCase {
 // order), so an export's memory does not grow with --rays.
 void for_each_probe_case(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays,
                          const std::function<void(const ProbeCase&)>& visit);
-std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
-                                   long long rays);
-std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed,
-                                     long long rays);
+std::vector<ProbeCase> probe_cases(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays);
+std::vector<SphereCase> sphere_cases(const Family& f, int sweep, Precision p, std::uint64_t seed, long long rays);
 // Probes per sweep value for a --rays budget (the unit of chunking).
 long long probes_per_sweep(const Family& f, int sweep, long long rays);
 

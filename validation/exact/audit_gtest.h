@@ -13,7 +13,8 @@
 // RegisterShardedAudit; it becomes N tests NAME/shard_K_of_N, which
 // GoogleTest deals one per shard, each judging 1/N of the rays (--shard K/N).
 //   static const bool reg = ra::audit::RegisterShardedAudit("Mine", "Watertight",
-//       [](const ra::audit::Shard& s) { EXPECT_TRUE(ra::audit::IsWatertight(mine(), {.rays = 10000000, .shard = s})); });
+//       [](const ra::audit::Shard& s) { EXPECT_TRUE(ra::audit::IsWatertight(mine(), {.rays = 10000000, .shard = s}));
+//       });
 // (A plain TEST runs on one shard only, so plain assertions judge every ray.)
 // Header-only: include it from a test linked to GTest and rayaudit::validation.
 #pragma once
@@ -37,8 +38,8 @@ struct CheckOptions {
   std::vector<std::string> families{};  // empty: the assertion's own default
   long long rays = 20000;
   std::uint64_t seed = 1;
-  int threads = 0;  // 0: all cores; the subject is called from that many threads at once
-  std::optional<Shard> shard{};         // unset: every ray
+  int threads = 0;               // 0: all cores; the subject is called from that many threads at once
+  std::optional<Shard> shard{};  // unset: every ray
   // Only these sweep values count (labels as the table prints them: "0",
   // "1e-06", "sphere@origin"); empty: all. Every family is still run.
   std::vector<std::string> sweeps{};
@@ -80,13 +81,14 @@ inline bool RegisterShardedAudit(const char* suite, const char* name, std::funct
     const std::string test =
         n == 1 ? std::string(name) : std::string(name) + "/shard_" + std::to_string(k) + "_of_" + std::to_string(n);
     ::testing::RegisterTest(suite, test.c_str(), nullptr, nullptr, file, line,
-                            [body, k, n]() -> detail::ShardedAuditTest* { return new detail::ShardedAuditTest(body, Shard{k, n}); });
+                            [body, k, n]() -> detail::ShardedAuditTest* {
+                              return new detail::ShardedAuditTest(body, Shard{k, n});
+                            });
   }
   return true;
 }
 
-inline Report run_check(const TriangleSubject& s, const CheckOptions& c,
-                        std::vector<std::string> default_families) {
+inline Report run_check(const TriangleSubject& s, const CheckOptions& c, std::vector<std::string> default_families) {
   Options o;
   o.families = c.families.empty() ? std::move(default_families) : c.families;
   o.rays = c.rays;
@@ -113,7 +115,8 @@ inline void check_sweeps(const CheckOptions& c, const Report& r) {
       found = found || cell.sweep_label == w;
       if (all.find(" " + cell.sweep_label + ",") == std::string::npos) all += " " + cell.sweep_label + ",";
     }
-    if (!found) throw std::invalid_argument("audit: sweep value '" + w + "' is in none of the families run (" + all + ")");
+    if (!found)
+      throw std::invalid_argument("audit: sweep value '" + w + "' is in none of the families run (" + all + ")");
   }
 }
 
@@ -144,8 +147,8 @@ inline ::testing::AssertionResult IsWatertight(const TriangleSubject& s, const C
     if (cell.stats.leaks || cell.stats.wrong_t || cell.stats.nan_inf) failing.push_back(cell.family);
     if (cell.stats.leaks) {
       leaks += cell.stats.leaks;
-      leaked << " " << cell.family << "@" << cell.sweep_label << ": " << cell.stats.leaks << "/"
-             << cell.stats.groups << ";";
+      leaked << " " << cell.family << "@" << cell.sweep_label << ": " << cell.stats.leaks << "/" << cell.stats.groups
+             << ";";
     }
     const std::uint64_t t = cell.stats.wrong_t + cell.stats.nan_inf;
     if (t) {
@@ -160,8 +163,11 @@ inline ::testing::AssertionResult IsWatertight(const TriangleSubject& s, const C
   if (leaks == 0 && bad == 0)
     return ::testing::AssertionSuccess() << s.name() << " did not leak on " << groups << " groups";
   auto failure = ::testing::AssertionFailure();
-  if (leaks) failure << s.name() << " leaked " << leaks << " of " << groups << " groups (seed " << c.seed << shard_note(c) << "):" << leaked.str();
-  else failure << s.name() << " did not leak on " << groups << " groups (seed " << c.seed << shard_note(c) << ")";
+  if (leaks)
+    failure << s.name() << " leaked " << leaks << " of " << groups << " groups (seed " << c.seed << shard_note(c)
+            << "):" << leaked.str();
+  else
+    failure << s.name() << " did not leak on " << groups << " groups (seed " << c.seed << shard_note(c) << ")";
   if (bad) failure << " and has " << bad << " hits with t NaN, infinite or off by more than 1%:" << bad_t.str();
   return failure << teaching_lines(r, c, failing);
 }
@@ -175,9 +181,9 @@ inline ::testing::AssertionResult HasNoWrongAnswers(const TriangleSubject& s, co
   std::vector<std::string> failing;
   for (const Cell& cell : r.cells)
     if (in_sweeps(c, cell) && cell.stats.wrong() + cell.stats.nan_inf > 0) {
-      bad << " " << cell.family << "@" << cell.sweep_label << ": " << cell.stats.false_hits
-          << " false hits, " << cell.stats.false_misses << " false misses, " << cell.stats.wrong_t
-          << " wrong t, " << cell.stats.nan_inf << " NaN;";
+      bad << " " << cell.family << "@" << cell.sweep_label << ": " << cell.stats.false_hits << " false hits, "
+          << cell.stats.false_misses << " false misses, " << cell.stats.wrong_t << " wrong t, " << cell.stats.nan_inf
+          << " NaN;";
       failing.push_back(cell.family);
     }
   if (bad.str().empty()) return ::testing::AssertionSuccess();
@@ -206,7 +212,8 @@ inline ::testing::AssertionResult IsNoWorseThan(const TriangleSubject& s, const 
   }
   std::ifstream in(baseline_json, std::ios::binary);
   if (!in)
-    return ::testing::AssertionFailure() << baseline_json << ": no baseline (run once with RAYAUDIT_UPDATE_BASELINE=1 "
+    return ::testing::AssertionFailure() << baseline_json
+                                         << ": no baseline (run once with RAYAUDIT_UPDATE_BASELINE=1 "
                                             "to write it from this run, or give an audit --json)";
   nlohmann::json base;
   try {
@@ -241,8 +248,11 @@ inline ::testing::AssertionResult IsNoWorseThan(const TriangleSubject& s, const 
   scope.sweeps = c.sweeps;
   try {
     const ra::baseline::Diff d = ra::baseline::compare(base, r.to_json(), scope);
-    if (d.worse()) return ::testing::AssertionFailure() << s.name() << " is worse than " << baseline_json << ": " << d.table(r.to_json());
-    return ::testing::AssertionSuccess() << s.name() << " is no worse than " << baseline_json << ": " << d.table(r.to_json());
+    if (d.worse())
+      return ::testing::AssertionFailure()
+             << s.name() << " is worse than " << baseline_json << ": " << d.table(r.to_json());
+    return ::testing::AssertionSuccess() << s.name() << " is no worse than " << baseline_json << ": "
+                                         << d.table(r.to_json());
   } catch (const ra::baseline::Mismatch& e) {
     return ::testing::AssertionFailure() << baseline_json << ": cannot be " << s.name() << "'s baseline: " << e.what();
   }

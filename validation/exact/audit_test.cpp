@@ -99,8 +99,7 @@ TEST(AuditCodeproject, FarRootOnEverySphereHitWithTwoPositiveRoots) {
           // method in that precision; 10^-6 (double) and 10^-2 (float) are far
           // beyond that.
           const double apart = p == Precision::f32 ? 1e-2 : 1e-6;
-          if (a.verdict != Verdict::hit || !std::isfinite(a.t_far) || !(a.t > 0) ||
-              a.t_far - a.t < apart * a.t_far)
+          if (a.verdict != Verdict::hit || !std::isfinite(a.t_far) || !(a.t > 0) || a.t_far - a.t < apart * a.t_far)
             continue;
           ++checked;
           double t;
@@ -114,8 +113,8 @@ TEST(AuditCodeproject, FarRootOnEverySphereHitWithTwoPositiveRoots) {
             t = h->t;
           }
           EXPECT_LT(std::abs(t - a.t_far), std::abs(t - a.t))
-              << precision_name(p) << " " << f.name << "@" << f.sweep[std::size_t(s)] << ": near " << a.t
-              << " far " << a.t_far << " codeproject " << t;
+              << precision_name(p) << " " << f.name << "@" << f.sweep[std::size_t(s)] << ": near " << a.t << " far "
+              << a.t_far << " codeproject " << t;
         }
     }
     EXPECT_GT(checked, 1000) << precision_name(p);
@@ -128,13 +127,14 @@ TEST(AuditStats, MedianAndMaxRelativeTErrorOfKnownErrors) {
   // A subject answering exactly what the oracle answers, with t multiplied by
   // (1 + r): every right hit has relative t error r (to a double rounding).
   for (double r : {0x1p-30, 0x1p-8, 0x1p+20}) {
-    auto s = triangle_subject<double>("scaled", [r](const ra::Rayd& ray, const ra::Vec3d& a,
-                                                    const ra::Vec3d& b, const ra::Vec3d& c)
-                                                     -> std::optional<ra::TriangleHit<double>> {
-      const auto o = ra::oracle::triangle(ray, a, b, c);
-      if (o.verdict != Verdict::hit && o.verdict != Verdict::boundary) return std::nullopt;
-      return ra::TriangleHit<double>{o.t * (1 + r), 0.25, 0.25};
-    });
+    auto s = triangle_subject<double>("scaled",
+                                      [r](const ra::Rayd& ray, const ra::Vec3d& a, const ra::Vec3d& b,
+                                          const ra::Vec3d& c) -> std::optional<ra::TriangleHit<double>> {
+                                        const auto o = ra::oracle::triangle(ray, a, b, c);
+                                        if (o.verdict != Verdict::hit && o.verdict != Verdict::boundary)
+                                          return std::nullopt;
+                                        return ra::TriangleHit<double>{o.t * (1 + r), 0.25, 0.25};
+                                      });
     const Stats st = run({s}, {}, opts({"random"}, 3000)).total(0);
     ASSERT_GT(st.t_samples, 100u);
     // The median reports its bin's lower bound: within 1/8 octave below r.
@@ -161,9 +161,12 @@ TEST(AuditFamilies, EdgeVertexAndClosedMeshRaysCrossExactlyOnTheSharedEdgeOrVert
             on_edge += a.verdict == Verdict::boundary && a.zero_edges == 1;
             at_vertex += a.verdict == Verdict::boundary && a.zero_edges == 2;
           }
-          if (f.name == "edge") exact += on_edge == 2;
-          else if (f.name == "vertex") exact += at_vertex == pc.answers.size();
-          else exact += on_edge + at_vertex >= 2;
+          if (f.name == "edge")
+            exact += on_edge == 2;
+          else if (f.name == "vertex")
+            exact += at_vertex == pc.answers.size();
+          else
+            exact += on_edge + at_vertex >= 2;
         }
         const double share = double(exact) / double(cases.size());
         EXPECT_GT(share, f.name == "closed-mesh" ? 0.4 : 0.6)
@@ -284,17 +287,16 @@ TEST(AuditEngine, CountsAddUp) {
   const ra::Method* m = ra::find_method("moller");
   const Report r = run({registry_triangle(*m, Precision::f64)}, {}, opts({}, 5000));
   const Stats s = r.total(0);
-  EXPECT_EQ(s.tests, s.true_hits + s.false_hits + s.true_misses + s.false_misses + s.boundary_hits +
-                         s.boundary_misses + s.coplanar_hits + s.coplanar_misses + s.degenerate_hits +
-                         s.degenerate_misses);
+  EXPECT_EQ(s.tests, s.true_hits + s.false_hits + s.true_misses + s.false_misses + s.boundary_hits + s.boundary_misses +
+                         s.coplanar_hits + s.coplanar_misses + s.degenerate_hits + s.degenerate_misses);
   EXPECT_GT(s.true_hits, 0u);
   EXPECT_GT(s.true_misses, 0u);
   EXPECT_GT(s.spawned, 0u);
 }
 
 TEST(AuditExport, RoundTripKeepsEveryVerdict) {
-  const auto rows = export_rows({"random", "edge", "vertex", "near-miss", "degenerate", "closed-mesh"},
-                                Precision::f64, 11, 3000);
+  const auto rows =
+      export_rows({"random", "edge", "vertex", "near-miss", "degenerate", "closed-mesh"}, Precision::f64, 11, 3000);
   ASSERT_GT(rows.size(), 1000u);
   const auto path = std::filesystem::temp_directory_path() / "rayaudit_roundtrip_test.csv";
   { std::ofstream(path) << cases_csv(rows); }
@@ -331,8 +333,10 @@ TEST(AuditCasesCsv, MalformedRowsNameFileAndLine) {
 
 TEST(AuditCasesCsv, HexAndDecimalFloatsAndIds) {
   const auto path = std::filesystem::temp_directory_path() / "rayaudit_good_cases_test.csv";
-  { std::ofstream(path) << "note,cz,cy,cx,bz,by,bx,az,ay,ax,dz,dy,dx,oz,oy,ox,id\n"
-                           "x,0,0x1p+0,0,0,0,1,0,0,0,-1,0,0,1,0.25,0.25,bug-17\n"; }
+  {
+    std::ofstream(path) << "note,cz,cy,cx,bz,by,bx,az,ay,ax,dz,dy,dx,oz,oy,ox,id\n"
+                           "x,0,0x1p+0,0,0,0,1,0,0,0,-1,0,0,1,0.25,0.25,bug-17\n";
+  }
   const auto cs = read_cases_csv(path.string());
   std::filesystem::remove(path);
   ASSERT_EQ(cs.size(), 1u);
@@ -351,7 +355,8 @@ TEST(AuditShards, ShardsPartitionEveryFamilyAndSweepValue) {
   const ra::Method* m = ra::find_method("moller");
   const ra::Method* k = ra::find_method("kraus");
   ASSERT_TRUE(m && k);
-  const std::vector<TriangleSubject> tris = {registry_triangle(*m, Precision::f32), registry_triangle(*m, Precision::f64)};
+  const std::vector<TriangleSubject> tris = {registry_triangle(*m, Precision::f32),
+                                             registry_triangle(*m, Precision::f64)};
   const std::vector<SphereSubject> sph = {registry_sphere(*k, Precision::f32)};
   Options whole = opts({"random", "edge", "closed-mesh", "secondary", "huge"}, 30000, 4);
   const Report all = run(tris, sph, whole);
@@ -423,8 +428,10 @@ TEST(AuditGrade, GradedAnswersOfAMethodEqualItsAudit) {
         h = m->tri_d.hit(r.ray, r.tri.a, r.tri.b, r.tri.c, false);
       }
       char buf[160];
-      if (h) std::snprintf(buf, sizeof buf, "%s,true,%a,%a,%a\n", r.id.c_str(), h->t, h->b1, h->b2);
-      else std::snprintf(buf, sizeof buf, "%s,false,,,\n", r.id.c_str());
+      if (h)
+        std::snprintf(buf, sizeof buf, "%s,true,%a,%a,%a\n", r.id.c_str(), h->t, h->b1, h->b2);
+      else
+        std::snprintf(buf, sizeof buf, "%s,false,,,\n", r.id.c_str());
       answers += buf;
     }
     { std::ofstream(cases_path) << cases_csv(rows); }

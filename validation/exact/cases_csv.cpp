@@ -61,8 +61,10 @@ std::vector<std::string> split_fields(const std::string& line, char sep) {
   std::vector<std::string> out;
   std::string cur;
   for (char ch : line) {
-    if (ch == sep) out.push_back(cur), cur.clear();
-    else cur += ch;
+    if (ch == sep)
+      out.push_back(cur), cur.clear();
+    else
+      cur += ch;
   }
   out.push_back(cur);
   for (auto& f : out) {
@@ -118,8 +120,9 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
     for (std::size_t i = 0; i < header.size(); ++i)
       if (header[i] == kColumns[k]) col[k] = int(i);
     if (col[k] < 0)
-      throw InputError(located(path, lineno, std::string("missing column '") + kColumns[k] +
-                                                 "' in the header (need ox,oy,oz,dx,dy,dz,ax,...,cz)"));
+      throw InputError(located(
+          path, lineno,
+          std::string("missing column '") + kColumns[k] + "' in the header (need ox,oy,oz,dx,dy,dz,ax,...,cz)"));
   }
   for (std::size_t i = 0; i < header.size(); ++i)
     if (header[i] == "id") id_col = int(i);
@@ -131,8 +134,9 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
     ++row;
     const auto f = split_fields(line);
     if (f.size() != header.size())
-      throw InputError(located(path, lineno, "expected " + std::to_string(header.size()) +
-                                                 " fields as in the header, found " + std::to_string(f.size())));
+      throw InputError(located(
+          path, lineno,
+          "expected " + std::to_string(header.size()) + " fields as in the header, found " + std::to_string(f.size())));
     double v[15];
     for (int k = 0; k < 15; ++k) {
       const bool number = parse_double(f[std::size_t(col[k])], v[k]);
@@ -141,8 +145,9 @@ void for_each_case(const std::string& path, const std::function<void(const UserC
         // number was quoted whole.
         const std::string& t = f[std::size_t(col[k])];
         const std::string shown = t.size() > 40 ? t.substr(0, 40) + "... (" + std::to_string(t.size()) + " bytes)" : t;
-        throw InputError(located(path, lineno, std::string("column '") + kColumns[k] + "': '" + shown +
-                                                   (number ? "' is not a finite number" : "' is not a number")));
+        throw InputError(located(path, lineno,
+                                 std::string("column '") + kColumns[k] + "': '" + shown +
+                                     (number ? "' is not a finite number" : "' is not a number")));
       }
     }
     UserCase c;
@@ -165,9 +170,8 @@ std::string cases_csv_header() {
 std::string cases_csv_row(const ExportRow& r, Numbers n) {
   std::string out;
   out.append(r.id).append(",").append(r.family).append(",").append(r.sweep);
-  const double v[15] = {r.ray.o.x, r.ray.o.y, r.ray.o.z, r.ray.d.x, r.ray.d.y, r.ray.d.z,
-                        r.tri.a.x, r.tri.a.y, r.tri.a.z, r.tri.b.x, r.tri.b.y, r.tri.b.z,
-                        r.tri.c.x, r.tri.c.y, r.tri.c.z};
+  const double v[15] = {r.ray.o.x, r.ray.o.y, r.ray.o.z, r.ray.d.x, r.ray.d.y, r.ray.d.z, r.tri.a.x, r.tri.a.y,
+                        r.tri.a.z, r.tri.b.x, r.tri.b.y, r.tri.b.z, r.tri.c.x, r.tri.c.y, r.tri.c.z};
   for (double x : v) out.append(",").append(number(x, n));
   out.append(",").append(oracle::verdict_name(r.answer.verdict)).append(",");
   if (std::isfinite(r.answer.t)) out.append(number(r.answer.t, n));
@@ -181,8 +185,8 @@ std::string cases_csv(const std::vector<ExportRow>& rows, Numbers n) {
   return out;
 }
 
-long long for_each_export_row(const std::vector<std::string>& fams, Precision p, std::uint64_t seed,
-                              long long rays, const std::function<void(const ExportRow&)>& visit) {
+long long for_each_export_row(const std::vector<std::string>& fams, Precision p, std::uint64_t seed, long long rays,
+                              const std::function<void(const ExportRow&)>& visit) {
   long long n = 0;
   for (const Family& f : families()) {
     if (f.kind != Kind::triangle || f.secondary) continue;
@@ -200,8 +204,8 @@ long long for_each_export_row(const std::vector<std::string>& fams, Precision p,
   return n;
 }
 
-std::vector<ExportRow> export_rows(const std::vector<std::string>& fams, Precision p,
-                                   std::uint64_t seed, long long rays) {
+std::vector<ExportRow> export_rows(const std::vector<std::string>& fams, Precision p, std::uint64_t seed,
+                                   long long rays) {
   std::vector<ExportRow> rows;
   for_each_export_row(fams, p, seed, rays, [&](const ExportRow& r) { rows.push_back(r); });
   return rows;

@@ -55,12 +55,12 @@ std::string cases_csv_row(const ExportRow& r, Numbers n = Numbers::hex);
 
 // The generated cases of the given triangle families (the secondary family,
 // whose rays depend on each method, and sphere families are skipped).
-std::vector<ExportRow> export_rows(const std::vector<std::string>& families, Precision p,
-                                   std::uint64_t seed, long long rays);
+std::vector<ExportRow> export_rows(const std::vector<std::string>& families, Precision p, std::uint64_t seed,
+                                   long long rays);
 // The same rows one at a time, in the same order, holding one probe's cases
 // at a time (2M rows held 1.7 GB). Returns the number of rows.
-long long for_each_export_row(const std::vector<std::string>& families, Precision p, std::uint64_t seed,
-                              long long rays, const std::function<void(const ExportRow&)>& visit);
+long long for_each_export_row(const std::vector<std::string>& families, Precision p, std::uint64_t seed, long long rays,
+                              const std::function<void(const ExportRow&)>& visit);
 
 // The fields of one CSV line split at `sep`, each trimmed of spaces and tabs
 // (shared by the cases and the graded answers readers).

@@ -73,10 +73,12 @@ TEST(ExampleUserIntersector, WrapperAroundRegistryWatertightPasses) {
 template <class Mangle>
 auto exact(Mangle mangle) {
   return ra::audit::triangle_subject<float>(
-      "exact", [mangle](const ra::Rayf& r, const ra::Vec3f& a, const ra::Vec3f& b, const ra::Vec3f& c)
-                   -> std::optional<ra::TriangleHit<float>> {
+      "exact",
+      [mangle](const ra::Rayf& r, const ra::Vec3f& a, const ra::Vec3f& b,
+               const ra::Vec3f& c) -> std::optional<ra::TriangleHit<float>> {
         const ra::oracle::Answer ans = ra::oracle::triangle(ra::Rayd(r), ra::Vec3d(a), ra::Vec3d(b), ra::Vec3d(c));
-        if (ans.verdict != ra::oracle::Verdict::hit && ans.verdict != ra::oracle::Verdict::boundary) return std::nullopt;
+        if (ans.verdict != ra::oracle::Verdict::hit && ans.verdict != ra::oracle::Verdict::boundary)
+          return std::nullopt;
         return ra::TriangleHit<float>{mangle(float(ans.t)), 0.25f, 0.25f};
       });
 }
@@ -113,8 +115,8 @@ TEST(ExampleUserIntersector, WatertightJudgesTheTOfHitsAndRefusesUnknownFamilies
 // A long audit spread over GoogleTest's shards: run with GTEST_TOTAL_SHARDS=N
 // and GTEST_SHARD_INDEX=0..N-1 (ctest does, per test; CI matrices can), each
 // shard judges its 1/N of the rays. Unsharded, it is one test judging them all.
-const bool kShardedExample = ra::audit::RegisterShardedAudit(
-    "ExampleShardedAudit", "NaiveLeaksInEveryShard", [](const ra::audit::Shard& shard) {
+const bool kShardedExample =
+    ra::audit::RegisterShardedAudit("ExampleShardedAudit", "NaiveLeaksInEveryShard", [](const ra::audit::Shard& shard) {
       const auto mine = ra::audit::triangle_subject<float>("naive", naive);
       const ra::audit::CheckOptions c{.families = {"edge"}, .rays = 60000, .shard = shard};
       const ::testing::AssertionResult wt = ra::audit::IsWatertight(mine, c);

@@ -1,5 +1,6 @@
 // Case families: random, edge, vertex, grazing, offset, distance, scale,
-// sliver, near-miss, degenerate, closed-mesh (Embree's WatertightTest placement), secondary; spheres huge, tiny-far, near-origin.
+// sliver, near-miss, degenerate, closed-mesh (Embree's WatertightTest placement), secondary; spheres huge, tiny-far,
+// near-origin.
 #include "families.h"
 
 #include <array>
@@ -26,9 +27,7 @@ struct Rng {
   }
   double uniform() { return double(next() >> 11) * 0x1p-53; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  double log_uniform(double lo, double hi) {
-    return std::exp(uniform(std::log(lo), std::log(hi)));
-  }
+  double log_uniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
   int below(int n) { return int(next() % std::uint64_t(n)); }
   Vec3d in_cube(double h) { return {uniform(-h, h), uniform(-h, h), uniform(-h, h)}; }
   Vec3d unit() {
@@ -57,8 +56,7 @@ const std::vector<double> kAngles = {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7};
 const std::vector<double> kScaleLo = {1e-8, 1e-4, 1, 1e4};  // each bucket spans 4 decades
 const std::vector<double> kAspects = {1e1, 1e2, 1e3, 1e4, 1e5, 1e6};
 const std::vector<int> kNearMissUlps = {1, 8, 64};
-const std::vector<std::string> kDegenerate = {"collinear", "repeated-vertex", "zero-direction",
-                                              "near-collinear"};
+const std::vector<std::string> kDegenerate = {"collinear", "repeated-vertex", "zero-direction", "near-collinear"};
 // The secondary family runs over the scale family's sweep (1e-8..1e8, 4 decades per value).
 const std::vector<double>& kSecondaryScales = kScaleLo;
 const std::vector<std::string> kStrategies = {"eps", "pov", "normal-offset", "ulp-offset"};
@@ -74,11 +72,14 @@ std::string label(double v) {
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
-template <class C> std::vector<std::string> labels(const C& c, const std::string& prefix = "") {
+template <class C>
+std::vector<std::string> labels(const C& c, const std::string& prefix = "") {
   std::vector<std::string> out;
   for (const auto& v : c) {
-    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>) out.push_back(prefix + v);
-    else out.push_back(prefix + label(double(v)));
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::string>)
+      out.push_back(prefix + v);
+    else
+      out.push_back(prefix + label(double(v)));
   }
   return out;
 }
@@ -94,11 +95,11 @@ struct Mesh {
 Mesh icosphere() {
   const double g = (1 + std::sqrt(5.0)) / 2;
   Mesh m;
-  m.v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-         {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  m.f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-         {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-         {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  m.v = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+         {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+  m.f = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+         {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+         {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   std::vector<std::array<int, 3>> f2;
   auto mid = [&](int i, int j) {
     m.v.push_back((m.v[i] + m.v[j]) * 0.5);
@@ -182,9 +183,7 @@ struct Grid {
 // Size of the local configuration at an offset: 1, or 64 grid steps when the
 // precision cannot resolve a unit-size configuration there (float at 1e7,
 // where the spacing is 1): a unit triangle would collapse onto a few points.
-double local_scale(double offset, Precision p) {
-  return std::max(1.0, 64 * Grid(offset + 16, p).h);
-}
+double local_scale(double offset, Precision p) { return std::max(1.0, 64 * Grid(offset + 16, p).h); }
 
 // ---------------------------------------------------- triangle makers ---
 void add_single(TriangleBatch& b, const Tri& t, const Rayd& r) {
@@ -415,10 +414,18 @@ void degenerate_case(Rng& g, int kind, TriangleBatch& b) {
   const Vec3d a = grid(2), e = grid(1);
   Tri t;
   switch (kind) {
-    case 0: t = {a, a + e, a + e * 2.0}; break;
-    case 1: t = {a, a + e, a}; break;
-    case 2: t = {a, a + e, a + grid(1)}; break;
-    default: t = {a, a + e, a + e * g.uniform(-1, 2)}; break;
+    case 0:
+      t = {a, a + e, a + e * 2.0};
+      break;
+    case 1:
+      t = {a, a + e, a};
+      break;
+    case 2:
+      t = {a, a + e, a + grid(1)};
+      break;
+    default:
+      t = {a, a + e, a + e * g.uniform(-1, 2)};
+      break;
   }
   const Vec3d aim = (t.a + t.b + t.c) / 3.0;
   Rayd r = aimed(aim + g.unit() * g.uniform(1, 3), aim);
@@ -501,8 +508,8 @@ int Family::tris_per_probe(int sweep_index) const {
 const std::vector<Family>& families() {
   static const std::vector<Family> all = [] {
     std::vector<Family> f;
-    auto add = [&](std::string name, Kind k, std::string param, std::vector<std::string> sweep,
-                   bool grouped = false, bool secondary = false) {
+    auto add = [&](std::string name, Kind k, std::string param, std::vector<std::string> sweep, bool grouped = false,
+                   bool secondary = false) {
       f.push_back({std::move(name), k, std::move(param), std::move(sweep), grouped, secondary});
     };
     add("random", Kind::triangle, "aim spread", {"0.5", "1", "2"});
@@ -515,8 +522,8 @@ const std::vector<Family>& families() {
     add("sliver", Kind::triangle, "aspect", labels(kAspects));
     add("near-miss", Kind::triangle, "ulps outside", labels(kNearMissUlps));
     add("degenerate", Kind::triangle, "kind", kDegenerate);
-    add("closed-mesh", Kind::triangle, "mesh@placement",
-        {"sphere@origin", "sphere@embree", "box@origin", "box@embree"}, true);
+    add("closed-mesh", Kind::triangle, "mesh@placement", {"sphere@origin", "sphere@embree", "box@origin", "box@embree"},
+        true);
     std::vector<std::string> sec;
     for (const auto& s : kStrategies)
       for (double sc : kSecondaryScales) sec.push_back(s + "@" + label(sc));
@@ -553,8 +560,7 @@ bool group_is_proper(const Tri* tris, int count, const Vec3d& d) {
   return faces_alike(std::vector<Tri>(tris, tris + count), d);
 }
 
-void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,
-              TriangleBatch& out) {
+void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count, TriangleBatch& out) {
   Rng g{stream};
   const std::size_t tri0 = out.tris.size(), probe0 = out.probes.size();
   const auto s = std::size_t(sweep);
@@ -562,25 +568,36 @@ void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int
     closed_mesh_cases(g, sweep, p, count, out);
   } else {
     for (int i = 0; i < count; ++i) {
-      if (f.name == "random") random_case(g, std::stod(f.sweep[s]), 1, {}, out);
-      else if (f.name == "edge") edge_case(g, kOffsets[s], p, out);
-      else if (f.name == "vertex") vertex_case(g, kOffsets[s], p, out);
-      else if (f.name == "grazing") grazing_case(g, kAngles[s], out);
-      else if (f.name == "offset") random_case(g, 1, 1, random_offset(g, kOffsetFamily[s]), out);
-      else if (f.name == "distance") distant_case(g, kTriangleDistances[s], out);
-      else if (f.name == "scale") random_case(g, 1, g.log_uniform(kScaleLo[s], kScaleLo[s] * 1e4), {}, out);
-      else if (f.name == "sliver") sliver_case(g, kAspects[s], out);
-      else if (f.name == "near-miss") near_miss_case(g, kNearMissUlps[s], p, out);
-      else if (f.name == "degenerate") degenerate_case(g, sweep, out);
-      else if (f.name == "secondary") secondary_case(g, sweep, out);
-      else throw std::logic_error("no triangle generator for family " + f.name);
+      if (f.name == "random")
+        random_case(g, std::stod(f.sweep[s]), 1, {}, out);
+      else if (f.name == "edge")
+        edge_case(g, kOffsets[s], p, out);
+      else if (f.name == "vertex")
+        vertex_case(g, kOffsets[s], p, out);
+      else if (f.name == "grazing")
+        grazing_case(g, kAngles[s], out);
+      else if (f.name == "offset")
+        random_case(g, 1, 1, random_offset(g, kOffsetFamily[s]), out);
+      else if (f.name == "distance")
+        distant_case(g, kTriangleDistances[s], out);
+      else if (f.name == "scale")
+        random_case(g, 1, g.log_uniform(kScaleLo[s], kScaleLo[s] * 1e4), {}, out);
+      else if (f.name == "sliver")
+        sliver_case(g, kAspects[s], out);
+      else if (f.name == "near-miss")
+        near_miss_case(g, kNearMissUlps[s], p, out);
+      else if (f.name == "degenerate")
+        degenerate_case(g, sweep, out);
+      else if (f.name == "secondary")
+        secondary_case(g, sweep, out);
+      else
+        throw std::logic_error("no triangle generator for family " + f.name);
     }
   }
   if (p == Precision::f32) round_to_float(out, tri0, probe0);
 }
 
-void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,
-              std::vector<SphereCase>& out) {
+void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count, std::vector<SphereCase>& out) {
   Rng g{stream};
   const std::size_t first = out.size();
   const auto s = std::size_t(sweep);

@@ -42,11 +42,11 @@ struct SphereCase {
 
 struct Family {
   std::string name;
-  Kind kind;                        // triangle or sphere
-  std::string param;                // what the sweep varies, e.g. "offset"
-  std::vector<std::string> sweep;   // one label per sweep value
-  bool grouped = false;             // probes hold several triangles
-  bool secondary = false;           // spawned rays (handled by the audit engine)
+  Kind kind;                       // triangle or sphere
+  std::string param;               // what the sweep varies, e.g. "offset"
+  std::vector<std::string> sweep;  // one label per sweep value
+  bool grouped = false;            // probes hold several triangles
+  bool secondary = false;          // spawned rays (handled by the audit engine)
   // Triangles each probe tests, for turning a case budget into probes.
   int tris_per_probe(int sweep_index) const;
 };
@@ -65,10 +65,8 @@ std::uint64_t stream_seed(std::uint64_t seed, const std::string& family, int swe
 // `count` probes of a triangle family. Cases are made in double; for f32 every
 // coordinate is then rounded to float, so the oracle judges what the float
 // method gets. near-miss steps in ulps of the requested precision.
-void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,
-              TriangleBatch& out);
-void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count,
-              std::vector<SphereCase>& out);
+void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count, TriangleBatch& out);
+void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int count, std::vector<SphereCase>& out);
 
 // A group judged for leaks: every triangle clearly faces the ray's direction
 // the same way (no fold seen along d, none edge-on or degenerate).

@@ -55,8 +55,9 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     const auto f = split_fields(line);
     if (f.size() != header.size())
-      throw InputError(located(path, lineno, "expected " + std::to_string(header.size()) +
-                                                 " fields as in the header, found " + std::to_string(f.size())));
+      throw InputError(located(
+          path, lineno,
+          "expected " + std::to_string(header.size()) + " fields as in the header, found " + std::to_string(f.size())));
     const std::string& key = f[std::size_t(id)];
     if (key.empty()) throw InputError(located(path, lineno, "empty id"));
     Given g;
@@ -72,8 +73,8 @@ std::unordered_map<std::string, Given> read_answers(const std::string& path) {
         throw InputError(located(path, lineno, std::string(name) + " '" + f[std::size_t(c)] + "' is not a number"));
     const auto [it, fresh] = out.emplace(key, g);
     if (!fresh)
-      throw InputError(located(path, lineno, "duplicate id '" + key + "' (first at line " +
-                                                 std::to_string(it->second.line) + ")"));
+      throw InputError(
+          located(path, lineno, "duplicate id '" + key + "' (first at line " + std::to_string(it->second.line) + ")"));
   }
   return out;
 }
@@ -129,8 +130,9 @@ Report grade_answers(const std::string& answers_csv, const std::string& cases_cs
     if (a == answers.end())
       throw InputError(located(cases_csv, line, "case '" + c.id + "' has no answer in " + answers_csv));
     if (a->second.used)
-      throw InputError(located(cases_csv, line, "duplicate case id '" + c.id + "' (its answer is " + answers_csv +
-                                                    ":" + std::to_string(a->second.line) + ")"));
+      throw InputError(located(cases_csv, line,
+                               "duplicate case id '" + c.id + "' (its answer is " + answers_csv + ":" +
+                                   std::to_string(a->second.line) + ")"));
     a->second.used = true;
     std::string family = "cases", sweep = "all", key;
     long k = 0;
@@ -138,13 +140,17 @@ Report grade_answers(const std::string& answers_csv, const std::string& cases_cs
     if (!grouped || key != cur.key) {
       flush();
       if (grouped && k != 0)
-        throw InputError(located(cases_csv, line, "case '" + c.id + "' does not follow the other rows of its ray "
-                                                  "(keep the export's order)"));
+        throw InputError(located(cases_csv, line,
+                                 "case '" + c.id +
+                                     "' does not follow the other rows of its ray "
+                                     "(keep the export's order)"));
       cur.key = grouped ? key : std::string();
       cur.family = family, cur.sweep = sweep, cur.ray = c.ray, cur.first_id = c.id;
     } else if (k != long(cur.tris.size()) || !(c.ray.o == cur.ray.o && c.ray.d == cur.ray.d)) {
-      throw InputError(located(cases_csv, line, "case '" + c.id + "' does not follow the other rows of its ray "
-                                                "(keep the export's order and rays)"));
+      throw InputError(located(cases_csv, line,
+                               "case '" + c.id +
+                                   "' does not follow the other rows of its ray "
+                                   "(keep the export's order and rays)"));
     }
     cur.tris.push_back(c.tri);
     cur.given.push_back(a->second.answer);

@@ -24,18 +24,22 @@ namespace ra::oracle {
 
 std::string_view verdict_name(Verdict v) {
   switch (v) {
-    case Verdict::hit: return "hit";
-    case Verdict::miss: return "miss";
-    case Verdict::boundary: return "boundary";
-    case Verdict::coplanar: return "coplanar";
-    case Verdict::degenerate: return "degenerate";
+    case Verdict::hit:
+      return "hit";
+    case Verdict::miss:
+      return "miss";
+    case Verdict::boundary:
+      return "boundary";
+    case Verdict::coplanar:
+      return "coplanar";
+    case Verdict::degenerate:
+      return "degenerate";
   }
   return "?";
 }
 
 bool parse_verdict(std::string_view s, Verdict& out) {
-  for (Verdict v : {Verdict::hit, Verdict::miss, Verdict::boundary, Verdict::coplanar,
-                    Verdict::degenerate})
+  for (Verdict v : {Verdict::hit, Verdict::miss, Verdict::boundary, Verdict::coplanar, Verdict::degenerate})
     if (verdict_name(v) == s) {
       out = v;
       return true;
@@ -67,9 +71,7 @@ struct IV {
 IV iv(const Vec3d& p) { return {I(p.x), I(p.y), I(p.z)}; }
 IV isub(const Vec3d& p, const Vec3d& q) { return {I(p.x) - I(q.x), I(p.y) - I(q.y), I(p.z) - I(q.z)}; }
 I idot(const IV& a, const IV& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-IV icross(const IV& a, const IV& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+IV icross(const IV& a, const IV& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 // The sign of an interval, or 2 when it straddles zero.
 int isign(const I& v) {
   if (v.inf() > 0) return 1;
@@ -88,8 +90,7 @@ enum class Filtered {
 // Decides the verdicts that need no exact t (miss, coplanar, degenerate) when
 // the intervals are conclusive, and certifies hits so the exact path computes
 // only t.
-Filtered filtered_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c,
-                           double lo, Answer& out) {
+Filtered filtered_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c, double lo, Answer& out) {
   constexpr Filtered decided = Filtered::decided;
   CGAL::Protect_FPU_rounding<true> guard;
   const IV n = icross(isub(b, a), isub(c, a));
@@ -105,8 +106,7 @@ Filtered filtered_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const 
     if (sN == 2) return Filtered::undecided;
     return out = make(sN == 0 ? Verdict::coplanar : Verdict::miss), decided;
   }
-  const int w[3] = {isign(idot(d, icross(ao, bo))), isign(idot(d, icross(bo, co))),
-                    isign(idot(d, icross(co, ao)))};
+  const int w[3] = {isign(idot(d, icross(ao, bo))), isign(idot(d, icross(bo, co))), isign(idot(d, icross(co, ao)))};
   for (int s : w)
     if (s == -sD) return out = make(Verdict::miss), decided;  // the line passes outside
   for (int s : w)
@@ -191,8 +191,8 @@ inline Vec3d pcross(const Vec3d& a, const Vec3d& b) {
 inline double pdot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 constexpr double kU2 = 0x1p-106;
-constexpr double kTriK = 256 * kU2;     // degree 3 (8 x 24 u^2, rounded up), see above
-constexpr double kSphK = 512 * kU2;     // degree 4 (8 x 64 u^2)
+constexpr double kTriK = 256 * kU2;       // degree 3 (8 x 24 u^2, rounded up), see above
+constexpr double kSphK = 512 * kU2;       // degree 4 (8 x 64 u^2)
 constexpr double kInflate = 1 + 0x1p-40;  // covers rounding in the permanents
 
 // sign of v when |v| > err, else 2 (undecided).
@@ -262,8 +262,8 @@ struct I256 {
 // point of an edge, as the audit's edge and vertex families are built on a
 // grid), where any filter can only say "too close to call"; else 2.
 int grid_det_sign(const DV& p, const DV& q, const Vec3d& d) {
-  const double xs[15] = {p.x.h, p.y.h, p.z.h, q.x.h, q.y.h, q.z.h, d.x, d.y, d.z,
-                         p.x.l, p.y.l, p.z.l, q.x.l, q.y.l, q.z.l};
+  const double xs[15] = {p.x.h, p.y.h, p.z.h, q.x.h, q.y.h, q.z.h, d.x,  d.y,
+                         d.z,   p.x.l, p.y.l, p.z.l, q.x.l, q.y.l, q.z.l};
   int lo = 10000, hi = -10000;
   for (double x : xs) range(x, lo, hi);
   if (lo == 10000) return 0;
@@ -343,8 +343,7 @@ bool dd_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c, 
   const int sD = dsign(D, eD);
   if (sD == 2) return false;  // maybe parallel
   if (t_only) return dd_t(N, D, eN, eD, out.t);
-  const double ew[3] = {kTriK * pdot(ad, pcross(aao, abo)) * kInflate,
-                        kTriK * pdot(ad, pcross(abo, aco)) * kInflate,
+  const double ew[3] = {kTriK * pdot(ad, pcross(aao, abo)) * kInflate, kTriK * pdot(ad, pcross(abo, aco)) * kInflate,
                         kTriK * pdot(ad, pcross(aco, aao)) * kInflate};
   // An exact zero: when d == P - o exactly for a vertex P (a ray aimed at a
   // vertex whose subtraction was exact), the two edge functions through P are
@@ -400,8 +399,7 @@ inline int cmp_enclosed(DD t, double err, double x) {
 // dd_triangle); tangent rays, roots on the window's ends and t too close to a
 // rounding midpoint are left to the exact path.
 bool dd_sphere(const Rayd& r, const Vec3d& center, double radius, double lo, double hi, Answer& out) {
-  if (!in_range({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, center.x, center.y, center.z, radius}, 4))
-    return false;
+  if (!in_range({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, center.x, center.y, center.z, radius}, 4)) return false;
   const DV f = dsub(r.o, center);
   const Vec3d af = vabs(f), ad = vabs(r.d);
   const DD A = two_prod(r.d.x, r.d.x) + two_prod(r.d.y, r.d.y) + two_prod(r.d.z, r.d.z);
@@ -567,8 +565,8 @@ double round_ratio(Scratch& s, const Z& num, const Z& den) {
 // t = N / D exactly rounded, for a crossing the filter already certified.
 double exact_t(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   Scratch& s = scratch();
-  const int E = common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y,
-                                 b.z, c.x, c.y, c.z});
+  const int E =
+      common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
   set_scaled(s.o, r.o, E), set_scaled(s.d, r.d, E);
   set_scaled(s.a, a, E), set_scaled(s.b, b, E), set_scaled(s.c, c, E);
   sub(s.e1, s.b, s.a), sub(s.e2, s.c, s.a);
@@ -583,8 +581,8 @@ double exact_t(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
 Answer exact_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c, double lo) {
   ++g_fallbacks;
   Scratch& s = scratch();
-  const int E = common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y,
-                                 b.z, c.x, c.y, c.z});
+  const int E =
+      common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
   set_scaled(s.o, r.o, E), set_scaled(s.d, r.d, E);
   set_scaled(s.a, a, E), set_scaled(s.b, b, E), set_scaled(s.c, c, E);
   sub(s.e1, s.b, s.a), sub(s.e2, s.c, s.a);
@@ -614,21 +612,23 @@ Answer exact_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d
 }  // namespace
 
 Answer triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  if (!(finite3(r.o) && finite3(r.d) && finite3(a) && finite3(b) && finite3(c)) ||
-      std::isnan(r.tmin) || std::isnan(r.tmax))
+  if (!(finite3(r.o) && finite3(r.d) && finite3(a) && finite3(b) && finite3(c)) || std::isnan(r.tmin) ||
+      std::isnan(r.tmax))
     return make(Verdict::degenerate);
   if (r.d.x == 0 && r.d.y == 0 && r.d.z == 0) return make(Verdict::degenerate);
   const double lo = std::max(r.tmin, 0.0);
   if (lo > r.tmax || std::isinf(lo)) return make(Verdict::miss);
   Answer out;
   switch (filtered_triangle(r, a, b, c, lo, out)) {
-    case Filtered::decided: return out;
+    case Filtered::decided:
+      return out;
     case Filtered::crossing:
       if (dd_triangle(r, a, b, c, lo, out, /*t_only=*/true)) return out;
       ++g_fallbacks;
       out.t = exact_t(r, a, b, c);
       return out;
-    case Filtered::undecided: break;
+    case Filtered::undecided:
+      break;
   }
   if (dd_triangle(r, a, b, c, lo, out)) return out;
   return exact_triangle(r, a, b, c, lo);
@@ -716,8 +716,8 @@ bool root_in_window(Scratch& sc, int s, double lo, double hi) {
 // the wrong side (OracleDD.SphereRootsWithin2ToMinus200OfAMidpoint), so the
 // MPFR value is only a guess that nearest_root settles exactly.
 void sphere_roots(Scratch& sc, double& t_near, double& t_far) {
-  const auto bits = std::max({mpz_sizeinbase(sc.sA.v, 2), mpz_sizeinbase(sc.sB.v, 2),
-                              mpz_sizeinbase(sc.sC.v, 2), mpz_sizeinbase(sc.disc.v, 2) / 2});
+  const auto bits = std::max({mpz_sizeinbase(sc.sA.v, 2), mpz_sizeinbase(sc.sB.v, 2), mpz_sizeinbase(sc.sC.v, 2),
+                              mpz_sizeinbase(sc.disc.v, 2) / 2});
   const auto prec = static_cast<mpfr_prec_t>(bits + 96);
   mpfr_set_prec(sc.big1, prec), mpfr_set_prec(sc.big2, prec), mpfr_set_prec(sc.big3, prec);
   mpfr_set_z(sc.big1, sc.disc.v, MPFR_RNDN);
@@ -739,8 +739,8 @@ void sphere_roots(Scratch& sc, double& t_near, double& t_far) {
 }  // namespace
 
 Answer sphere(const Rayd& r, const Vec3d& center, double radius) {
-  if (!(finite3(r.o) && finite3(r.d) && finite3(center) && std::isfinite(radius)) ||
-      std::isnan(r.tmin) || std::isnan(r.tmax) || !(radius > 0))
+  if (!(finite3(r.o) && finite3(r.d) && finite3(center) && std::isfinite(radius)) || std::isnan(r.tmin) ||
+      std::isnan(r.tmax) || !(radius > 0))
     return make(Verdict::degenerate);
   if (r.d.x == 0 && r.d.y == 0 && r.d.z == 0) return make(Verdict::degenerate);
   const double lo = std::max(r.tmin, 0.0), hi = r.tmax;
@@ -758,8 +758,7 @@ Answer sphere(const Rayd& r, const Vec3d& center, double radius) {
   }
   ++g_fallbacks;
   Scratch& sc = scratch();
-  const int E = common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, center.x, center.y,
-                                 center.z, radius});
+  const int E = common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, center.x, center.y, center.z, radius});
   set_scaled(sc.o, r.o, E), set_scaled(sc.d, r.d, E), set_scaled(sc.c, center, E);
   set_scaled(sc.N, radius, E);
   sub(sc.ao, sc.o, sc.c);  // f = o - center

@@ -220,9 +220,7 @@ Q3 operator-(const Q3& a, const Q3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z
 Q3 operator+(const Q3& a, const Q3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 Q3 operator*(const Q3& a, const mpq_class& s) { return {a.x * s, a.y * s, a.z * s}; }
 mpq_class qdot(const Q3& a, const Q3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Q3 qcross(const Q3& a, const Q3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+Q3 qcross(const Q3& a, const Q3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 
 // A rational rounded to the nearest double (ties to even), subnormals
 // included, in integers: q = floor(|v| 2^k) with 2^52 <= q < 2^53 (k at most
@@ -238,12 +236,17 @@ double round_q(const mpq_class& v) {
     k = std::min(k, 1074L);
     mpz_class nk = num;
     dk = den;
-    if (k >= 0) nk <<= k;
-    else dk <<= -k;
+    if (k >= 0)
+      nk <<= k;
+    else
+      dk <<= -k;
     mpz_fdiv_qr(q.get_mpz_t(), r.get_mpz_t(), nk.get_mpz_t(), dk.get_mpz_t());
-    if (q >= hi) --k;
-    else if (q < lo && k < 1074) ++k;
-    else break;
+    if (q >= hi)
+      --k;
+    else if (q < lo && k < 1074)
+      ++k;
+    else
+      break;
   }
   const int c = cmp(mpz_class(2 * r), dk);
   if (c > 0 || (c == 0 && mpz_odd_p(q.get_mpz_t()))) ++q;
@@ -260,11 +263,9 @@ ra::oracle::Answer ref_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, c
   const mpq_class den = qdot(n, d), num = qdot(n, A - o);
   if (den == 0) return ans.verdict = num == 0 ? Verdict::coplanar : Verdict::miss, ans;
   const mpq_class t = num / den;
-  if (t < std::max(r.tmin, 0.0) || (std::isfinite(r.tmax) && t > r.tmax))
-    return ans.verdict = Verdict::miss, ans;
+  if (t < std::max(r.tmin, 0.0) || (std::isfinite(r.tmax) && t > r.tmax)) return ans.verdict = Verdict::miss, ans;
   const Q3 P = o + d * t;
-  const mpq_class l[3] = {qdot(n, qcross(C - B, P - B)), qdot(n, qcross(A - C, P - C)),
-                          qdot(n, qcross(B - A, P - A))};
+  const mpq_class l[3] = {qdot(n, qcross(C - B, P - B)), qdot(n, qcross(A - C, P - C)), qdot(n, qcross(B - A, P - A))};
   int zeros = 0;
   for (const auto& x : l) {
     if (x < 0) return ans.verdict = Verdict::miss, ans;
@@ -296,8 +297,8 @@ TEST(OracleReference, EveryTriangleFamilyAgreesWithRationals) {
         generate(f, s, p, stream_seed(11, f.name, s, 0), f.name == "closed-mesh" ? 8 : 40, b);
         for (const Probe& pr : b.probes)
           for (int k = pr.first; k < pr.first + pr.count; ++k) {
-            SCOPED_TRACE(f.name + " sweep " + f.sweep[std::size_t(s)] + " " + precision_name(p) +
-                         " triangle " + std::to_string(k));
+            SCOPED_TRACE(f.name + " sweep " + f.sweep[std::size_t(s)] + " " + precision_name(p) + " triangle " +
+                         std::to_string(k));
             const Tri& t = b.tris[std::size_t(k)];
             expect_same(ra::oracle::triangle(pr.ray, t.a, t.b, t.c), ref_triangle(pr.ray, t.a, t.b, t.c));
           }
@@ -432,9 +433,7 @@ ra::oracle::Answer ref_sphere(const Rayd& r, const Vec3d& center, double radius)
   mpfr_sub(t1, tmp, s, MPFR_RNDN), mpfr_add(t2, tmp, s, MPFR_RNDN);
   mpfr_set_q(tmp, A.get_mpq_t(), MPFR_RNDN);
   mpfr_div(t1, t1, tmp, MPFR_RNDN), mpfr_div(t2, t2, tmp, MPFR_RNDN);
-  auto in = [&](mpfr_t t) {
-    return mpfr_cmp_d(t, lo) >= 0 && (!std::isfinite(hi) || mpfr_cmp_d(t, hi) <= 0);
-  };
+  auto in = [&](mpfr_t t) { return mpfr_cmp_d(t, lo) >= 0 && (!std::isfinite(hi) || mpfr_cmp_d(t, hi) <= 0); };
   const bool near_in = in(t1), far_in = in(t2);
   const double n = mpfr_get_d(t1, MPFR_RNDN), fa = mpfr_get_d(t2, MPFR_RNDN);
   mpfr_clears(s, t1, t2, tmp, static_cast<mpfr_ptr>(nullptr));
@@ -447,8 +446,10 @@ ra::oracle::Answer ref_sphere(const Rayd& r, const Vec3d& center, double radius)
 
 void expect_same_sphere(const ra::oracle::Answer& got, const ra::oracle::Answer& want) {
   expect_same(got, want);
-  if (std::isnan(want.t_far)) EXPECT_TRUE(std::isnan(got.t_far));
-  else EXPECT_EQ(got.t_far, want.t_far);
+  if (std::isnan(want.t_far))
+    EXPECT_TRUE(std::isnan(got.t_far));
+  else
+    EXPECT_EQ(got.t_far, want.t_far);
 }
 
 TEST(OracleReference, EverySphereFamilyAgreesWithRationals) {
@@ -479,7 +480,8 @@ TEST(OracleReference, TangentRaysAreBoundaryWithExactT) {
       const double R = std::ldexp(1.0, int(u(g) * 10));
       const Vec3d c{off + std::round(u(g) * 1024) / 64, std::round(u(g) * 1024) / 64, -off};
       // A ray along z passing at distance exactly R from the centre in x.
-      const Rayd r{c + Vec3d{R, 0, -R * (3 + std::round(std::abs(u(g)) * 64) / 8)}, {0, 0, std::ldexp(1.0, int(u(g) * 4))}};
+      const Rayd r{c + Vec3d{R, 0, -R * (3 + std::round(std::abs(u(g)) * 64) / 8)},
+                   {0, 0, std::ldexp(1.0, int(u(g) * 4))}};
       SCOPED_TRACE("offset " + std::to_string(off) + " case " + std::to_string(i));
       const auto want = ref_sphere(r, c, R);
       ASSERT_EQ(want.verdict, Verdict::boundary);
@@ -513,7 +515,6 @@ TEST(OracleReference, TwoRootAndNearTangentRays) {
     }
   }
 }
-
 
 // ------------------------------------------- double-double filter attacks ---
 // The oracle's second filter (oracle.cpp, "double-double") evaluates signs and
@@ -573,8 +574,9 @@ Vec3d scale(const Vec3d& v, int s) { return {std::ldexp(v.x, s), std::ldexp(v.y,
 // whether the filters decided the scaled query or GMP did.
 void check_tri(const TriCase& k, int& decided, int& fell_back) {
   const auto want = ref_triangle(k.r, k.a, k.b, k.c);
-  const int s = fit_scale({k.r.o.x, k.r.o.y, k.r.o.z, k.r.d.x, k.r.d.y, k.r.d.z, k.a.x, k.a.y, k.a.z, k.b.x,
-                           k.b.y, k.b.z, k.c.x, k.c.y, k.c.z}, 310);
+  const int s = fit_scale({k.r.o.x, k.r.o.y, k.r.o.z, k.r.d.x, k.r.d.y, k.r.d.z, k.a.x, k.a.y, k.a.z, k.b.x, k.b.y,
+                           k.b.z, k.c.x, k.c.y, k.c.z},
+                          310);
   const Rayd r{scale(k.r.o, s), scale(k.r.d, s), k.r.tmin, k.r.tmax};
   const auto before = ra::oracle::exact_fallbacks();
   const auto got = ra::oracle::triangle(r, scale(k.a, s), scale(k.b, s), scale(k.c, s));
@@ -653,8 +655,8 @@ TEST(OracleDD, EdgeAndVertexFunctionsBelowDoubleDoubleResolution) {
       for (int i = 0; i < 10; ++i) {
         const auto cases = edge_and_vertex_cases(g, off, sz, true);
         for (std::size_t j = 0; j < cases.size(); ++j) {
-          SCOPED_TRACE("offset " + std::to_string(off) + " size " + std::to_string(sz) + " case " +
-                       std::to_string(i) + " variant " + std::to_string(j));
+          SCOPED_TRACE("offset " + std::to_string(off) + " size " + std::to_string(sz) + " case " + std::to_string(i) +
+                       " variant " + std::to_string(j));
           check_tri(cases[j], decided, fell_back);
           exact_zero += cases[j].r.d.z == 0;
         }
@@ -707,8 +709,10 @@ TEST(OracleDD, NearParallelAndNearCoplanarRays) {
 // triangle has its centroid P = o + m d, all inputs exact and the differences
 // A - o etc. about 80 bits wide, so double-double rounds throughout.
 mpq_class ldexp_q(mpq_class x, int e) {
-  if (e >= 0) mpq_mul_2exp(x.get_mpq_t(), x.get_mpq_t(), mp_bitcnt_t(e));
-  else mpq_div_2exp(x.get_mpq_t(), x.get_mpq_t(), mp_bitcnt_t(-e));
+  if (e >= 0)
+    mpq_mul_2exp(x.get_mpq_t(), x.get_mpq_t(), mp_bitcnt_t(e));
+  else
+    mpq_div_2exp(x.get_mpq_t(), x.get_mpq_t(), mp_bitcnt_t(-e));
   return x;
 }
 
@@ -720,8 +724,8 @@ TEST(OracleDD, TriangleTOnAndNextToAMidpointOrADouble) {
     const int em = int(g() % 16) - 6;
     // Odd cases: M even, so m is a double and the crossing is exactly on it.
     const bool on_double = i % 2 == 1;
-    const std::uint64_t M = ((std::uint64_t(1) << 53) | (g() & ((std::uint64_t(1) << 53) - 1)) | 1) -
-                            (on_double ? 1 : 0);
+    const std::uint64_t M =
+        ((std::uint64_t(1) << 53) | (g() & ((std::uint64_t(1) << 53) - 1)) | 1) - (on_double ? 1 : 0);
     const mpq_class m = ldexp_q(mpq_class(mpz_class(static_cast<unsigned long>(M))), em - 53);
     Vec3d d, P, o, e1, e2;
     bool exact = true;
@@ -756,8 +760,7 @@ TEST(OracleDD, TriangleTOnAndNextToAMidpointOrADouble) {
           SCOPED_TRACE("o[" + std::to_string(k) + "] moved by 2^-" + std::to_string(j) + " |P|");
           check_tri(v, decided, fell_back);
           if (on_double && k == 0 && (j == 94 || j == 100 || j == 106)) {
-            check_windows(v, ref_triangle(v.r, a, b, c).t,
-                          [&](const TriCase& w) { check_tri(w, decided, fell_back); });
+            check_windows(v, ref_triangle(v.r, a, b, c).t, [&](const TriCase& w) { check_tri(w, decided, fell_back); });
           }
         }
   }
@@ -879,30 +882,30 @@ TEST(OracleDD, SphereRootsOnAndNextToAMidpointOrADouble) {
 TEST(OracleDD, SphereRootsWithin2ToMinus200OfAMidpoint) {
   // o, d (the centre is 0) and the radius.
   const double rows[][7] = {
-      {-4051195949526708, 7782850023437287, 1586050764232668,
-       2487679796734386, -4188179493722325, -769072061172422, 697007832366653},
-      {5766628429972556, 1027167417059215, 1393763842728614,
-       -3320671313103007, -704778725147500, -872828286441607, 593272807863166},
-      {-5525577283384923, 6056897100884350, 4266243655226884,
-       3548706529094099, -4273450995290750, -3452550127959786, 1121031510358420},
-      {-3941095255883726, 1649599564797516, -2849806317028729,
-       3153854704130562, -755640185435070, 2500862218253773, 1122718083529185},
-      {-2920281676067117, 622507534702456, -6499219931495391,
-       2151335861665850, -884944214738875, 4317732885062178, 1036226799415471},
-      {-3688909925777730, -4271221313648234, -5100990862023190,
-       2825292349285864, 3638798435719075, 4308719982865379, 1024000611980459},
-      {6333393374454317, 6105515012816005, 5960057286416992,
-       -3224029221767026, -3152106002396731, -3053747686934438, 929986196951221},
-      {-3448660098367940, 855968227025046, 3614291412412241,
-       2344914797331730, -255861418477873, -2001656729949843, 709135337676511},
-      {-2290723716561240, -1178486710247122, 4319379762138714,
-       2087273616343293, 1001661033713798, -2820511738386296, 787123383079334},
-      {-5744206471290976, -4781838772127429, 2958981472031143,
-       3635088414265972, 2197821710752683, -1668660670524170, 1124082602744863},
-      {5372664883307192, 3642900129514919, 7487584694122443,
-       -3183726190753343, -1839023056067541, -4174743016064142, 674108326895953},
-      {5731415092197240, -1292495903330821, 1326867641558878,
-       -3365097265105696, 411532107883973, -552719448956643, 836267257647740},
+      {-4051195949526708, 7782850023437287, 1586050764232668, 2487679796734386, -4188179493722325, -769072061172422,
+       697007832366653},
+      {5766628429972556, 1027167417059215, 1393763842728614, -3320671313103007, -704778725147500, -872828286441607,
+       593272807863166},
+      {-5525577283384923, 6056897100884350, 4266243655226884, 3548706529094099, -4273450995290750, -3452550127959786,
+       1121031510358420},
+      {-3941095255883726, 1649599564797516, -2849806317028729, 3153854704130562, -755640185435070, 2500862218253773,
+       1122718083529185},
+      {-2920281676067117, 622507534702456, -6499219931495391, 2151335861665850, -884944214738875, 4317732885062178,
+       1036226799415471},
+      {-3688909925777730, -4271221313648234, -5100990862023190, 2825292349285864, 3638798435719075, 4308719982865379,
+       1024000611980459},
+      {6333393374454317, 6105515012816005, 5960057286416992, -3224029221767026, -3152106002396731, -3053747686934438,
+       929986196951221},
+      {-3448660098367940, 855968227025046, 3614291412412241, 2344914797331730, -255861418477873, -2001656729949843,
+       709135337676511},
+      {-2290723716561240, -1178486710247122, 4319379762138714, 2087273616343293, 1001661033713798, -2820511738386296,
+       787123383079334},
+      {-5744206471290976, -4781838772127429, 2958981472031143, 3635088414265972, 2197821710752683, -1668660670524170,
+       1124082602744863},
+      {5372664883307192, 3642900129514919, 7487584694122443, -3183726190753343, -1839023056067541, -4174743016064142,
+       674108326895953},
+      {5731415092197240, -1292495903330821, 1326867641558878, -3365097265105696, 411532107883973, -552719448956643,
+       836267257647740},
   };
   std::vector<SphCase> cases;
   for (const auto& v : rows) cases.push_back({Rayd{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}}, {0, 0, 0}, v[6]});
@@ -955,8 +958,8 @@ TEST(OracleDD, ScaledByPowersOfTwoAcrossTheRangeGuard) {
            std::ldexp(std::ldexp(v.z, s), -s) == v.z;
   };
   int checked = 0, decided = 0, fell_back = 0, guard_passed = 0, guard_refused = 0;
-  for (int s : {-700, -400, -355, -345, -330, -300, -280, -272, -268, -255, -250, -240, -200, 250, 280, 290, 300,
-                320, 400, 600}) {
+  for (int s : {-700, -400, -355, -345, -330, -300, -280, -272, -268, -255,
+                -250, -240, -200, 250,  280,  290,  300,  320,  400,  600}) {
     for (std::size_t i = 0; i < tris.size(); ++i) {
       const TriCase& t = tris[i];
       if (!exact(t.r.o, s) || !exact(t.r.d, s) || !exact(t.a, s) || !exact(t.b, s) || !exact(t.c, s)) continue;

@@ -84,7 +84,8 @@ std::vector<Box> boxes(const std::vector<Vec3d>& v, const std::vector<std::array
   std::vector<Box> out;
   for (const auto& f : faces) {
     Box b{v[std::size_t(f[0])], v[std::size_t(f[0])]};
-    for (int k = 1; k < 3; ++k) b.lo = vmin(b.lo, v[std::size_t(f[std::size_t(k)])]), b.hi = vmax(b.hi, v[std::size_t(f[std::size_t(k)])]);
+    for (int k = 1; k < 3; ++k)
+      b.lo = vmin(b.lo, v[std::size_t(f[std::size_t(k)])]), b.hi = vmax(b.hi, v[std::size_t(f[std::size_t(k)])]);
     const double pad = 1e-9 * std::max(max_component(abs(b.lo)), max_component(abs(b.hi))) + 1e-300;
     b.lo = b.lo - Vec3d{pad, pad, pad};
     b.hi = b.hi + Vec3d{pad, pad, pad};
@@ -122,9 +123,7 @@ bool oracle_meets(const Rayd& r, const std::vector<Vec3d>& v, const std::vector<
   return false;
 }
 
-void paint(float* px, double r, double g, double b) {
-  px[0] = float(r), px[1] = float(g), px[2] = float(b);
-}
+void paint(float* px, double r, double g, double b) { px[0] = float(r), px[1] = float(g), px[2] = float(b); }
 
 // Runs body(row) for every row on `threads` threads.
 void parallel_rows(int rows, int threads, const std::function<void(int)>& body) {
@@ -160,9 +159,8 @@ ClosedMesh audit_sphere() {
     std::array<int, 3> f{};
     const Vec3d* c[3] = {&t.a, &t.b, &t.c};
     for (int k = 0; k < 3; ++k) {
-      auto it = std::find_if(m.positions.begin(), m.positions.end(), [&](const Vec3d& p) {
-        return p.x == c[k]->x && p.y == c[k]->y && p.z == c[k]->z;
-      });
+      auto it = std::find_if(m.positions.begin(), m.positions.end(),
+                             [&](const Vec3d& p) { return p.x == c[k]->x && p.y == c[k]->y && p.z == c[k]->z; });
       f[std::size_t(k)] = int(it - m.positions.begin());
       if (it == m.positions.end()) m.positions.push_back(*c[k]);
     }
@@ -241,8 +239,10 @@ std::vector<Map> render_maps(const std::vector<ClosedMesh>& meshes, const Option
             hit[i] = h.has_value();
             float* px = map.image.at(x, y);
             if (!h) {
-              if (meets[i]) paint(px, 0.9, 0.0, 0.0);
-              else paint(px, 1, 1, 1);
+              if (meets[i])
+                paint(px, 0.9, 0.0, 0.0);
+              else
+                paint(px, 1, 1, 1);
               continue;
             }
             if (!exact[i]) {
@@ -251,7 +251,8 @@ std::vector<Map> render_maps(const std::vector<ClosedMesh>& meshes, const Option
             }
             // Grey by the angle to the face (float-rounded triangle's normal).
             const auto& f = mesh.faces[std::size_t(h->prim)];
-            const Vec3d ng = cross(fv[std::size_t(f[1])] - fv[std::size_t(f[0])], fv[std::size_t(f[2])] - fv[std::size_t(f[0])]);
+            const Vec3d ng =
+                cross(fv[std::size_t(f[1])] - fv[std::size_t(f[0])], fv[std::size_t(f[2])] - fv[std::size_t(f[0])]);
             const double len = length(ng);
             const double c = len > 0 ? std::abs(dot(ng / len, normalize(rays[i].d))) : 0;
             const double g = 0.3 + 0.55 * c;

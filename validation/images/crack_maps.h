@@ -29,21 +29,21 @@ ClosedMesh audit_sphere();
 ClosedMesh closed_obj(const std::filesystem::path& file);
 
 struct Options {
-  int size = 96;                                    // square maps, pixels a side
-  std::vector<double> offsets{1, 1e3, 1e5, 1e7};    // mesh centre at (o, o, o)
-  std::vector<std::string> methods;                 // empty: every triangle method
-  int threads = 0;                                  // 0: all cores
+  int size = 96;                                  // square maps, pixels a side
+  std::vector<double> offsets{1, 1e3, 1e5, 1e7};  // mesh centre at (o, o, o)
+  std::vector<std::string> methods;               // empty: every triangle method
+  int threads = 0;                                // 0: all cores
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
 struct Map {
   std::string mesh, method;
   double offset = 0;
-  Image image;  // grey: hit; red: leak; blue: hit where exactly nothing is; white: background
-  long long pixels = 0;       // size * size
-  long long surface = 0;      // pixels whose ray meets the mesh (oracle or watertight)
-  long long leaks = 0;        // of those, where this method hits nothing
-  long long false_hits = 0;   // hits where the oracle finds no crossing
+  Image image;               // grey: hit; red: leak; blue: hit where exactly nothing is; white: background
+  long long pixels = 0;      // size * size
+  long long surface = 0;     // pixels whose ray meets the mesh (oracle or watertight)
+  long long leaks = 0;       // of those, where this method hits nothing
+  long long false_hits = 0;  // hits where the oracle finds no crossing
 };
 
 // One map per mesh x offset x method (mesh-major). The oracle judges the

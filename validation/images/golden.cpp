@@ -96,9 +96,9 @@ RenderOptions options_from(const json& s) {
 }
 
 json to_json(const GoldenEntry& e) {
-  json j = {{"name", e.name},     {"scene", e.scene},       {"image", e.image},   {"width", e.width},
-            {"height", e.height}, {"bits", e.bits},         {"settings", e.settings},
-            {"inputs_hash", e.inputs_hash},                 {"inputs", e.inputs}};
+  json j = {{"name", e.name},     {"scene", e.scene}, {"image", e.image},       {"width", e.width},
+            {"height", e.height}, {"bits", e.bits},   {"settings", e.settings}, {"inputs_hash", e.inputs_hash},
+            {"inputs", e.inputs}};
   // Written only when set, so the defaults' manifests stay as they were.
   if (e.max_side != kGoldenMaxSize) j["max_side"] = e.max_side;
   if (!e.tolerance.identical())
@@ -152,16 +152,18 @@ GoldenEntry entry_from(const json& j, const std::string& at, const Fail& fail) {
     if (b != 8 && b != 16) fail(at + "/bits", "must be 8 or 16, got " + shown(b));
     e.bits = b.get<int>();
   }
-  if (j.contains("max_side"))
-    e.max_side = integer(j.at("max_side"), at + "/max_side", 1, kMaxImageSide, " pixels");
+  if (j.contains("max_side")) e.max_side = integer(j.at("max_side"), at + "/max_side", 1, kMaxImageSide, " pixels");
   if (j.contains("tolerance")) {
     const json& t = j.at("tolerance");
-    if (!t.is_object()) fail(at + "/tolerance", "expected an object {\"max_levels\": L, \"max_pixels\": P}, got " + shown(t));
+    if (!t.is_object())
+      fail(at + "/tolerance", "expected an object {\"max_levels\": L, \"max_pixels\": P}, got " + shown(t));
     for (auto it = t.begin(); it != t.end(); ++it)
       if (it.key() != "max_levels" && it.key() != "max_pixels") fail(at + "/tolerance/" + it.key(), "unknown key");
-    if (t.contains("max_levels")) e.tolerance.max_levels = integer(t.at("max_levels"), at + "/tolerance/max_levels", 0, 65535, " levels");
+    if (t.contains("max_levels"))
+      e.tolerance.max_levels = integer(t.at("max_levels"), at + "/tolerance/max_levels", 0, 65535, " levels");
     if (t.contains("max_pixels"))
-      e.tolerance.max_pixels = integer(t.at("max_pixels"), at + "/tolerance/max_pixels", 0, kMaxImageSide * kMaxImageSide / 4, " pixels");
+      e.tolerance.max_pixels =
+          integer(t.at("max_pixels"), at + "/tolerance/max_pixels", 0, kMaxImageSide * kMaxImageSide / 4, " pixels");
   }
   e.settings = default_settings();
   if (j.contains("settings")) {
@@ -177,7 +179,8 @@ GoldenEntry entry_from(const json& j, const std::string& at, const Fail& fail) {
   if (j.contains("inputs")) {
     const json& in = j.at("inputs");
     if (!in.is_object()) fail(at + "/inputs", "expected an object, got " + shown(in));
-    for (auto it = in.begin(); it != in.end(); ++it) e.inputs[it.key()] = string(it.value(), at + "/inputs/" + it.key());
+    for (auto it = in.begin(); it != in.end(); ++it)
+      e.inputs[it.key()] = string(it.value(), at + "/inputs/" + it.key());
   }
   return e;
 }
@@ -230,11 +233,11 @@ std::string settings_problem(const json& s, std::string* key) {
   }
   v.clear();
   if (!text("precision", v)) return "expected a string";
-  if (s.contains("precision") && v != "float" && v != "double") return "precision must be float or double, got \"" + v + "\"";
+  if (s.contains("precision") && v != "float" && v != "double")
+    return "precision must be float or double, got \"" + v + "\"";
   v.clear();
   if (!text("self_intersection", v)) return "expected a string";
-  if (s.contains("self_intersection") && !parse_self_intersection(v))
-    return "unknown self_intersection \"" + v + "\"";
+  if (s.contains("self_intersection") && !parse_self_intersection(v)) return "unknown self_intersection \"" + v + "\"";
   v.clear();
   if (!text("accel", v)) return "expected a string";
   if (s.contains("accel") && !parse_accel(v)) return "unknown accel \"" + v + "\"";
@@ -259,8 +262,10 @@ std::string changed_inputs(const std::map<std::string, std::string>& then,
   auto add = [&](const std::string& s) { out += (out.empty() ? "" : ", ") + s; };
   for (const auto& [f, h] : now) {
     auto it = then.find(f);
-    if (it == then.end()) add(f + " (new)");
-    else if (it->second != h) add(f + " (changed)");
+    if (it == then.end())
+      add(f + " (new)");
+    else if (it->second != h)
+      add(f + " (changed)");
   }
   for (const auto& [f, h] : then)
     if (!now.count(f)) add(f + " (no longer used)");
@@ -323,7 +328,7 @@ std::string combined_hash(const std::map<std::string, std::string>& inputs) {
 GoldenSet::GoldenSet(fs::path root) : root_(std::move(root)) {
   const fs::path m = root_ / "golden" / "manifest.json";
   if (!fs::exists(m)) return;
-  JsonLines lines;  // every error names its line
+  JsonLines lines;                                    // every error names its line
   const json j = read_json_file(m.string(), &lines);  // FILE:LINE errors, duplicate keys refused
   try {
     if (!j.is_object() || !j.contains("goldens") || !j.at("goldens").is_array())
@@ -401,8 +406,9 @@ std::vector<fs::path> GoldenSet::diff_outputs(const std::string& name, const fs:
 std::string GoldenSet::bless_command(const std::string& name) const {
   std::error_code ec;
   // The name as typed when it is one plain word; the root always quoted.
-  const bool plain = !name.empty() && name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                                             "0123456789._/+-") == std::string::npos;
+  const bool plain = !name.empty() && name.find_first_not_of(
+                                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                          "0123456789._/+-") == std::string::npos;
   return "rayaudit golden bless " + (plain ? name : shell_quoted(name)) + " --root " +
          shell_quoted(fs::absolute(root_, ec).lexically_normal().string());
 }
@@ -410,9 +416,9 @@ std::string GoldenSet::bless_command(const std::string& name) const {
 GoldenSet::Reference GoldenSet::reference_of(const std::string& name) const {
   auto it = entries_.find(name);
   if (it == entries_.end())
-    throw InputError(located((root_ / "golden" / "manifest.json").string(), 0,
-                             "no golden \"" + name + "\" to judge an image against; record one with `" +
-                                 bless_command(name) + "`"));
+    throw InputError(
+        located((root_ / "golden" / "manifest.json").string(), 0,
+                "no golden \"" + name + "\" to judge an image against; record one with `" + bless_command(name) + "`"));
   return {it->second.width, it->second.height, it->second.bits, it->second.image};
 }
 
@@ -499,8 +505,8 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
   d["scene_height"] = sh;
   auto sx = [&](int x) { return scene_pixel(x, g.width, sw); };
   auto sy = [&](int y) { return scene_pixel(y, g.height, sh); };
-  d["max_error_pixel"] = {{"x", sx(c.max_x)}, {"y", sy(c.max_y)}, {"golden_x", c.max_x}, {"golden_y", c.max_y},
-                          {"channel", c.max_channel}};
+  d["max_error_pixel"] = {
+      {"x", sx(c.max_x)}, {"y", sy(c.max_y)}, {"golden_x", c.max_x}, {"golden_y", c.max_y}, {"channel", c.max_channel}};
   nlohmann::json diffs = nlohmann::json::array();
   for (const auto& p : c.differences)
     diffs.push_back({{"x", sx(p.x)}, {"y", sy(p.y)}, {"golden_x", p.x}, {"golden_y", p.y}, {"levels", p.levels}});
@@ -543,10 +549,11 @@ GoldenSet::Result GoldenSet::check(const std::string& name, const fs::path& diff
   ImageComparison shown = c;
   shown.max_x = sx(c.max_x);
   shown.max_y = sy(c.max_y);
-  r.message = name + ": " + (theirs ? what + " " : "") + (within ? "matches " : "differs from ") + g.image + " (" +
-              size + (g.width == sw && g.height == sh ? "" : ", the scene's " + std::to_string(sw) + "x" +
-                                                              std::to_string(sh) + " scaled") +
-              "): " + verdict + "\n" + summary(shown);
+  r.message =
+      name + ": " + (theirs ? what + " " : "") + (within ? "matches " : "differs from ") + g.image + " (" + size +
+      (g.width == sw && g.height == sh ? ""
+                                       : ", the scene's " + std::to_string(sw) + "x" + std::to_string(sh) + " scaled") +
+      "): " + verdict + "\n" + summary(shown);
   r.message += "coordinates are scene pixels (of " + std::to_string(sw) + "x" + std::to_string(sh) + ")";
   if (g.width != sw || g.height != sh) r.message += "; the golden and diff images are " + size;
   r.message += "\nfirst differences:";
@@ -610,9 +617,8 @@ std::string GoldenSet::bless(const std::string& name, OutputBatch* batch) {
         write_png = false;
         what = name + ": image unchanged";
       } else {
-        what = name + ": image changed: " + std::to_string(c.differences.size()) + " of " +
-               std::to_string(c.pixels) + " pixels differ, max " + std::to_string(long(std::lround(c.max_error * 255))) +
-               "/255";
+        what = name + ": image changed: " + std::to_string(c.differences.size()) + " of " + std::to_string(c.pixels) +
+               " pixels differ, max " + std::to_string(long(std::lround(c.max_error * 255))) + "/255";
       }
     } else {
       what = name + ": size changed to " + std::to_string(g.width) + "x" + std::to_string(g.height);
@@ -637,16 +643,18 @@ std::string GoldenSet::bless(const std::string& name, OutputBatch* batch) {
 void GoldenSet::save(OutputBatch* batch) const {
   json all = json::array();
   for (const auto& [n, e] : entries_) all.push_back(to_json(e));
-  json j = {{"about", "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
-                      "`rayaudit golden check` (ctest label golden), rewritten only by `rayaudit golden bless`. "
-                      "Each is its scene rendered at most \"max_side\" pixels on the long side (default 160) and "
-                      "must match within \"tolerance\" {\"max_levels\": L, \"max_pixels\": P} (default "
-                      "identical); both may be set per golden."},
+  json j = {{"about",
+             "Golden images of scenes/*.json, rendered by rayaudit itself; checked by "
+             "`rayaudit golden check` (ctest label golden), rewritten only by `rayaudit golden bless`. "
+             "Each is its scene rendered at most \"max_side\" pixels on the long side (default 160) and "
+             "must match within \"tolerance\" {\"max_levels\": L, \"max_pixels\": P} (default "
+             "identical); both may be set per golden."},
             {"goldens", all}};
   std::error_code ec;
   fs::create_directories(root_ / "golden", ec);
   if (batch) batch->add_replacement(root_ / "golden" / "manifest.json");
-  write_text_atomically(root_ / "golden" / "manifest.json", j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  write_text_atomically(root_ / "golden" / "manifest.json",
+                        j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   if (batch) batch->commit();  // the images and the manifest together
   for (const auto& f : to_remove_) fs::remove(f, ec);
 }

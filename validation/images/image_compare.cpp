@@ -40,7 +40,8 @@ ImageComparison compare_images(const Image& ours, const Image& theirs, int bits)
   // compare() also sets the error flag whenever nfail > 0, so its has_error()
   // is not a failure of the comparison itself (../shared/POVRAY.md).
   image_module::CompareStats r;
-  image_module::api().compare(a.width, a.height, a.rgb.data(), b.rgb.data(), threshold(4, bits), threshold(1, bits), &r);
+  image_module::api().compare(a.width, a.height, a.rgb.data(), b.rgb.data(), threshold(4, bits), threshold(1, bits),
+                              &r);
   c.mean_error = r.mean_error;
   c.rms_error = r.rms_error;
   c.psnr = r.psnr;
@@ -84,10 +85,14 @@ Image difference_image(const Image& ours, const Image& theirs, int bits) {
       // Brightness grows with the error in 8-bit levels, from 0.5 to 1.
       const double l8 = levels * 255.0 / m;
       const float v = float(0.5 + 0.5 * std::min(1.0, std::log2(1 + l8) / 8));
-      if (l8 <= 1) px[0] = 0, px[1] = 0, px[2] = v;
-      else if (l8 <= 4) px[0] = 0, px[1] = v, px[2] = 0;
-      else if (l8 <= 16) px[0] = v, px[1] = v, px[2] = 0;
-      else px[0] = v, px[1] = 0, px[2] = 0;
+      if (l8 <= 1)
+        px[0] = 0, px[1] = 0, px[2] = v;
+      else if (l8 <= 4)
+        px[0] = 0, px[1] = v, px[2] = 0;
+      else if (l8 <= 16)
+        px[0] = v, px[1] = v, px[2] = 0;
+      else
+        px[0] = v, px[1] = 0, px[2] = 0;
     }
   return out;
 }
@@ -153,8 +158,7 @@ std::string summary(const ImageComparison& c) {
                 "max error: %.6g (%g levels) at pixel (%d, %d) channel %d\n"
                 "pixels off by more than 1/255: %ld; by more than 4/255: %ld\n",
                 c.pixels, c.width, c.height, c.bits, c.identical() ? "true" : "false", c.differences.size(),
-                c.mean_error, c.rms_error,
-                std::isfinite(c.psnr) ? std::to_string(c.psnr).c_str() : "inf", c.max_error,
+                c.mean_error, c.rms_error, std::isfinite(c.psnr) ? std::to_string(c.psnr).c_str() : "inf", c.max_error,
                 std::round(c.max_error * m), c.max_x, c.max_y, c.max_channel, c.over_1, c.over_4);
   return buf;
 }

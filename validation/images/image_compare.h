@@ -24,8 +24,8 @@ struct ImageComparison {
   long pixels = 0;
   double mean_error = 0, rms_error = 0, psnr = 0, max_error = 0;
   int max_x = 0, max_y = 0, max_channel = 0;
-  long over_1 = 0, over_4 = 0;                // pixels off by more than 1/255, 4/255
-  std::vector<PixelDifference> differences;   // every pixel that differs at all, row by row
+  long over_1 = 0, over_4 = 0;               // pixels off by more than 1/255, 4/255
+  std::vector<PixelDifference> differences;  // every pixel that differs at all, row by row
   bool identical() const { return differences.empty(); }
 };
 
@@ -41,7 +41,7 @@ Image difference_image(const Image& ours, const Image& theirs, int bits);
 // of the largest channel difference, in 8-bit levels (at 16 bits, a
 // difference counts as levels * 255 / 65535), with its colour.
 struct DifferenceBand {
-  std::string colour;  // "grey", "blue", ...
+  std::string colour;                  // "grey", "blue", ...
   int min_levels = 0, max_levels = 0;  // 8-bit levels; max -1: no bound
   std::string meaning;
 };

@@ -273,7 +273,8 @@ std::vector<PixelExplanation> explain_differences(const Scene& scene, const Imag
     // POV's shadow cache
     Ray<double> r = camera.ray(d.x + 0.5, d.y + 0.5);
     r.tmin = kPovMinIsectDepth;
-    if (const auto hit = tracer.intersect(r); !is_skipped(skip, "shadow cache") && hit && luminance(pov.at(d.x, d.y)) < luminance(ours.at(d.x, d.y))) {
+    if (const auto hit = tracer.intersect(r);
+        !is_skipped(skip, "shadow cache") && hit && luminance(pov.at(d.x, d.y)) < luminance(ours.at(d.x, d.y))) {
       const Vec3d p = r.at(hit->t);
       for (std::size_t li = 0; li < scene.lights.size(); ++li) {
         const Vec3d lv = scene.lights[li].position - p;

@@ -43,10 +43,11 @@ std::string rgb(const Color& c) { return "rgb " + vec(c); }
 // Fresnel: POV's reflection { min, max fresnel on } with min 0 and
 // conserve_energy (transmission less what is reflected).
 std::string finish(const Material& m) {
-  const std::string reflection =
-      m.fresnel ? "reflection { rgb 0, " + rgb(m.reflection) + " fresnel on } conserve_energy" : "reflection { " + rgb(m.reflection) + " }";
-  return "finish { ambient " + rgb(m.ambient) + " diffuse " + num(m.diffuse) + " brilliance 1 phong " +
-         num(m.phong) + " phong_size " + num(m.phong_size) + " specular 0 " + reflection + " }";
+  const std::string reflection = m.fresnel
+                                     ? "reflection { rgb 0, " + rgb(m.reflection) + " fresnel on } conserve_energy"
+                                     : "reflection { " + rgb(m.reflection) + " }";
+  return "finish { ambient " + rgb(m.ambient) + " diffuse " + num(m.diffuse) + " brilliance 1 phong " + num(m.phong) +
+         " phong_size " + num(m.phong_size) + " specular 0 " + reflection + " }";
 }
 
 // The pigment's filter and transmit (rgbft), only where light passes, so an
@@ -128,8 +129,8 @@ void write_mesh2(std::ostringstream& out, const TriangleSet& set, ImageNames& na
     out << "// mesh " << comment_text(std::filesystem::path(set.name).filename().string()) << ": no triangles\n";
     return;
   }
-  out << "// mesh " << comment_text(std::filesystem::path(set.name).filename().string()) << ", "
-      << set.triangles.size() << " triangles\nmesh2 {\n  vertex_vectors { " << set.positions.size();
+  out << "// mesh " << comment_text(std::filesystem::path(set.name).filename().string()) << ", " << set.triangles.size()
+      << " triangles\nmesh2 {\n  vertex_vectors { " << set.positions.size();
   for (const auto& p : set.positions) out << ",\n    " << vec(p);
   out << " }\n";
 
@@ -183,8 +184,7 @@ void write_mesh2(std::ostringstream& out, const TriangleSet& set, ImageNames& na
       const auto& v = tri.v;
       const auto& n = tri.n;
       out << ",\n    "
-          << (has(n) ? idx3(n[0], n[1], n[2])
-                     : idx3(computed_base + v[0], computed_base + v[1], computed_base + v[2]));
+          << (has(n) ? idx3(n[0], n[1], n[2]) : idx3(computed_base + v[0], computed_base + v[1], computed_base + v[2]));
     }
     out << " }\n";
   }
@@ -222,7 +222,8 @@ std::optional<std::string> float_images(const Material& m, std::map<std::filesys
       }
     }
     if (it->second)
-      return "texture " + f->string() + " stores floating-point values, which POV-Ray's image maps (8 or 16-bit "
+      return "texture " + f->string() +
+             " stores floating-point values, which POV-Ray's image maps (8 or 16-bit "
              "integers) cannot hold: save it as an 8 or 16-bit PNG";
   }
   return std::nullopt;
@@ -277,7 +278,8 @@ PovExport export_pov(const Scene& scene, const std::string& image_prefix) {
       << "#version 3.7;\n"
       << "global_settings { assumed_gamma 1.0 ambient_light " << rgb(scene.ambient_light) << " max_trace_level "
       << scene.max_depth << " adc_bailout " << num(scene.adc_bailout) << " }\n"
-      << "background { " << rgb(scene.background) << " }\n"
+      << "background { " << rgb(scene.background)
+      << " }\n"
       // A negative right makes POV's left-handed camera right-handed like
       // ours; sky is our up, and `up y` only gives |up| = 1 and the handedness.
       << "camera { perspective location " << vec(cam.position) << " sky " << vec(cam.up) << " up y right <"
@@ -312,13 +314,15 @@ void copy_pov_image(const std::filesystem::path& source, const std::filesystem::
   std::vector<unsigned char> png;
   std::string err;
   switch (image_module::api().rgb_png(source.c_str(), &png, &err)) {
-    case 0: break;
-    case 1: throw InputError(located(source.string(), 0, "cannot read image: " + err));
-    default: throw InputError(located(dest.string(), 0, "cannot encode PNG: " + err));
+    case 0:
+      break;
+    case 1:
+      throw InputError(located(source.string(), 0, "cannot read image: " + err));
+    default:
+      throw InputError(located(dest.string(), 0, "cannot encode PNG: " + err));
   }
-  write_atomically(dest, [&](const std::filesystem::path& tmp) {
-    write_bytes_checked(tmp, png.data(), png.size(), dest.string());
-  });
+  write_atomically(
+      dest, [&](const std::filesystem::path& tmp) { write_bytes_checked(tmp, png.data(), png.size(), dest.string()); });
 }
 
 }  // namespace ra

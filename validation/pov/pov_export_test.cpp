@@ -84,9 +84,8 @@ TEST(PovExport, WritesEveryFinishTermAndGlobalSetting) {
   s.max_depth = 7;
   const std::string sdl = export_pov(s).sdl;
   for (const char* want : {"assumed_gamma 1.0", "max_trace_level 7", "adc_bailout 0.00392156862745098",
-                           "ambient_light rgb <1,1,1>", "right <-1.3333333333333333,0,0>", "ambient rgb",
-                           "diffuse 0.6", "brilliance 1", "phong 0", "phong_size 40", "specular 0",
-                           "reflection { rgb <0.5,0.25,0> }"})
+                           "ambient_light rgb <1,1,1>", "right <-1.3333333333333333,0,0>", "ambient rgb", "diffuse 0.6",
+                           "brilliance 1", "phong 0", "phong_size 40", "specular 0", "reflection { rgb <0.5,0.25,0> }"})
     EXPECT_NE(sdl.find(want), std::string::npos) << want << "\n" << sdl;
 }
 
@@ -175,8 +174,7 @@ TEST(PovExport, HostileTextureNameCannotInjectSdl) {
   } catch (const CheckFailed&) {
     // The injected SDL does not parse to the end; the file is written first.
   }
-  EXPECT_TRUE(fs::exists(target)) << "the control did not create " << target
-                                  << ": this test no longer proves anything";
+  EXPECT_TRUE(fs::exists(target)) << "the control did not create " << target << ": this test no longer proves anything";
   fs::remove_all(dir);
 }
 

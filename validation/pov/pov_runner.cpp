@@ -121,7 +121,8 @@ ProcessRun run_process(const fs::path& dir, const std::vector<std::string>& argv
     }
   g_child = 0;
   run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  run.cpu_s = double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  run.cpu_s =
+      double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
 }
@@ -148,8 +149,7 @@ std::string pov_ini(int bits) {
   return "; rayaudit's own settings: one ray per pixel, linear output, fixed render order.\n"
          "Antialias=Off\nDisplay=Off\nPause_When_Done=Off\nVerbose=Off\nOutput_File_Type=N\n"
          "Bits_Per_Color=" +
-         std::to_string(bits) +
-         "\nFile_Gamma=1.0\nQuality=9\nWork_Threads=1\nOutput_Alpha=Off\nOutput_To_File=On\n";
+         std::to_string(bits) + "\nFile_Gamma=1.0\nQuality=9\nWork_Threads=1\nOutput_Alpha=Off\nOutput_To_File=On\n";
 }
 
 PovRun render_with_povray(const Scene& scene, const PovRunOptions& options) {

@@ -15,8 +15,8 @@
 namespace ra {
 
 struct PovRunOptions {
-  int bits = 8;           // Bits_Per_Color: 8 or 16
-  bool keep_dir = false;  // keep the working directory (its path is in PovRun::dir)
+  int bits = 8;                 // Bits_Per_Color: 8 or 16
+  bool keep_dir = false;        // keep the working directory (its path is in PovRun::dir)
   bool keep_on_failure = true;  // keep it when POV-Ray fails, to look at
 };
 

@@ -17,8 +17,8 @@
 namespace ra {
 
 struct ExplainedComparison {
-  int differing = 0;                         // pixels that differ at 8 bits
-  std::vector<PixelExplanation> pixels;      // every differing pixel, cause empty when unknown
+  int differing = 0;                     // pixels that differ at 8 bits
+  std::vector<PixelExplanation> pixels;  // every differing pixel, cause empty when unknown
   int unexplained() const;
 };
 

@@ -28,8 +28,10 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
     for (const char* k : {"width", "height", "max_levels_16"})
       if (j.contains(k) && !j.at(k).is_number_integer())
         throw InputError(file.string() + ": /" + k + ": expected an integer");
-    if (j.contains("notes") && !j.at("notes").is_string()) throw InputError(file.string() + ": /notes: expected a string");
-    if (j.contains("pixels") && !j.at("pixels").is_array()) throw InputError(file.string() + ": /pixels: expected an array");
+    if (j.contains("notes") && !j.at("notes").is_string())
+      throw InputError(file.string() + ": /notes: expected a string");
+    if (j.contains("pixels") && !j.at("pixels").is_array())
+      throw InputError(file.string() + ": /pixels: expected an array");
     t.notes = j.value("notes", "");
     // Sizes and pixel coordinates inside the render limit (a pixel at x -1
     // was accepted and never matched; 3e9 wrapped round as an int).
@@ -39,7 +41,8 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
         throw InputError(where + ": " + v.dump() + " is outside " + std::to_string(lo) + ".." + std::to_string(hi));
       const long long x = v.get<long long>();
       if (x < lo || x > hi)
-        throw InputError(where + ": " + std::to_string(x) + " is outside " + std::to_string(lo) + ".." + std::to_string(hi));
+        throw InputError(where + ": " + std::to_string(x) + " is outside " + std::to_string(lo) + ".." +
+                         std::to_string(hi));
       return int(x);
     };
     const long long kSide = (long long)kMaxImageSide;
@@ -55,8 +58,7 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
       const std::string at = file.string() + ": /pixels/" + std::to_string(i);
       if (!p.is_object()) throw InputError(at + ": expected an object {\"x\", \"y\", \"levels\", \"cause\"}");
       for (const char* k : {"x", "y", "levels"})
-        if (p.contains(k) && !p.at(k).is_number_integer())
-          throw InputError(at + "/" + k + ": expected an integer");
+        if (p.contains(k) && !p.at(k).is_number_integer()) throw InputError(at + "/" + k + ": expected an integer");
       if (p.contains("cause") && !p.at("cause").is_string()) throw InputError(at + "/cause: expected a string");
       for (auto it = p.begin(); it != p.end(); ++it)
         if (it.key() != "x" && it.key() != "y" && it.key() != "levels" && it.key() != "cause")
@@ -75,8 +77,9 @@ PovTolerance load_pov_tolerance(const std::filesystem::path& file) {
       if (e.cause.empty()) throw InputError(at + ": every listed pixel needs its cause");
       // A pixel listed twice was accepted, the later entry silently winning.
       if (const auto [it, fresh] = first_at.try_emplace({e.x, e.y}, i); !fresh)
-        throw InputError(located(at, 0, "pixel (" + std::to_string(e.x) + ", " + std::to_string(e.y) +
-                                            ") listed twice (first at /pixels/" + std::to_string(it->second) + ")"));
+        throw InputError(located(at, 0,
+                                 "pixel (" + std::to_string(e.x) + ", " + std::to_string(e.y) +
+                                     ") listed twice (first at /pixels/" + std::to_string(it->second) + ")"));
       t.pixels.push_back(e);
     }
   } catch (const nlohmann::json::exception& e) {
@@ -118,8 +121,8 @@ PovVerdict judge(const ImageComparison& c, const PovTolerance& t) {
   }
   for (const auto& [xy, p] : listed)
     if (!seen.count(xy))
-      v.lines.push_back("pixel (" + std::to_string(xy.first) + ", " + std::to_string(xy.second) +
-                        ") is listed in " + where + " but no longer differs: remove it");
+      v.lines.push_back("pixel (" + std::to_string(xy.first) + ", " + std::to_string(xy.second) + ") is listed in " +
+                        where + " but no longer differs: remove it");
   return v;
 }
 

@@ -114,7 +114,8 @@ TEST(PovTolerance, ReadsTheFileAndRefusesUnknownKeys) {
 // float32 ones 1).
 TEST(PovTolerance, ShippedFilesListTheirLevels) {
   int files = 0;
-  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(RAYAUDIT_SOURCE_DIR) / "scenes" / "pov")) {
+  for (const auto& e :
+       std::filesystem::directory_iterator(std::filesystem::path(RAYAUDIT_SOURCE_DIR) / "scenes" / "pov")) {
     if (e.path().extension() != ".json") continue;
     ++files;
     const PovTolerance t = load_pov_tolerance(e.path());

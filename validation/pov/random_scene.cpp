@@ -21,10 +21,9 @@ using json = nlohmann::json;
 
 // Corpus meshes of up to ~10k triangles (../shared/CORPUS.md), and images.
 constexpr const char* kMeshes[] = {
-    "ladder/box.obj",          "ladder/cornell_box.obj",     "ladder/cube_poly_cgal.obj",
-    "ladder/spider.obj",       "ladder/teapot.obj",          "ladder/bunny_npm.obj",
-    "ladder/elephant_cgal.obj", "ladder/cheese-ball.obj",    "assimp-obj/WusonOBJ.obj",
-    "assimp-obj/cube_usemtl.obj", "assimp-obj/empty_mat.obj", "assimp-obj/regr01.obj",
+    "ladder/box.obj",          "ladder/cornell_box.obj",     "ladder/cube_poly_cgal.obj", "ladder/spider.obj",
+    "ladder/teapot.obj",       "ladder/bunny_npm.obj",       "ladder/elephant_cgal.obj",  "ladder/cheese-ball.obj",
+    "assimp-obj/WusonOBJ.obj", "assimp-obj/cube_usemtl.obj", "assimp-obj/empty_mat.obj",  "assimp-obj/regr01.obj",
     "embree/cornell_box.obj",  "generated/teapot.obj",
 };
 constexpr const char* kTextures[] = {
@@ -130,8 +129,7 @@ json material(Draw& d, bool with_uv) {
   }
   if (with_uv && d.chance(0.6)) {
     const auto tex = random_scene_textures();
-    if (!tex.empty())
-      m["texture"] = {{"file", d.pick(tex)}, {"filter", d.chance(0.7) ? "bilinear" : "nearest"}};
+    if (!tex.empty()) m["texture"] = {{"file", d.pick(tex)}, {"filter", d.chance(0.7) ? "bilinear" : "nearest"}};
   }
   return m;
 }
@@ -208,9 +206,7 @@ json random_scene(std::uint64_t seed, int index) {
   // A camera 4 to 9 away, above the horizon mostly, looking near the origin.
   Vec3d dir = d.unit();
   dir.y = std::abs(dir.y) * (d.chance(0.85) ? 1 : -1);
-  s["camera"] = {{"position", to_json(dir * d.uniform(4, 9))},
-                 {"look_at", d.vec(-0.5, 0.5)},
-                 {"vfov", d.nice(25, 65)}};
+  s["camera"] = {{"position", to_json(dir * d.uniform(4, 9))}, {"look_at", d.vec(-0.5, 0.5)}, {"vfov", d.nice(25, 65)}};
   if (d.chance(0.2)) s["camera"]["up"] = to_json(normalize(Vec3d{d.uniform(-0.5, 0.5), 1, d.uniform(-0.5, 0.5)}));
   s["background"] = d.chance(0.5) ? d.vec(0, 0.6) : json(0);
   if (d.chance(0.3)) s["ambient_light"] = colour(d);
@@ -229,10 +225,14 @@ json random_scene(std::uint64_t seed, int index) {
   if (d.chance(0.6)) objects.push_back(plane(d));
   for (int k = d.integer(1, 5); k > 0; --k) {
     const double r = d.uniform(0, 1);
-    if (r < 0.35 && !meshes.empty()) objects.push_back(mesh(d, meshes));
-    else if (r < 0.7) objects.push_back(sphere(d));
-    else if (r < 0.85) objects.push_back(triangle(d));
-    else objects.push_back(plane(d));
+    if (r < 0.35 && !meshes.empty())
+      objects.push_back(mesh(d, meshes));
+    else if (r < 0.7)
+      objects.push_back(sphere(d));
+    else if (r < 0.85)
+      objects.push_back(triangle(d));
+    else
+      objects.push_back(plane(d));
   }
   s["objects"] = objects;
   return s;

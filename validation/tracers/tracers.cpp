@@ -70,12 +70,12 @@ IntersectFn embree(const Mesh& m, bool robust) {
   RTCScene scene = rtcNewScene(dev);
   if (robust) rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
   RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                        3 * sizeof(float), m.positions.size()));
+  auto* v = static_cast<float*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.positions.size()));
   for (std::size_t i = 0; i < m.positions.size(); ++i)
     for (int k = 0; k < 3; ++k) v[3 * i + std::size_t(k)] = float(m.positions[i][k]);
-  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             3 * sizeof(unsigned), m.triangles.size()));
+  auto* idx = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.triangles.size()));
   for (std::size_t i = 0; i < m.triangles.size(); ++i)
     for (int k = 0; k < 3; ++k) idx[3 * i + std::size_t(k)] = unsigned(m.triangles[i][std::size_t(k)]);
   rtcCommitGeometry(g);
@@ -117,12 +117,16 @@ IntersectFn cgal(const Mesh& m) {
   s->tree = std::make_unique<Tree>(s->tris.begin(), s->tris.end());
   s->tree->build();
   return [s](const Rayd& r) -> std::optional<Hit> {
-    const auto h = s->tree->first_intersection(K::Ray_3(K::Point_3(r.o.x, r.o.y, r.o.z), K::Vector_3(r.d.x, r.d.y, r.d.z)));
+    const auto h =
+        s->tree->first_intersection(K::Ray_3(K::Point_3(r.o.x, r.o.y, r.o.z), K::Vector_3(r.d.x, r.d.y, r.d.z)));
     if (!h) return std::nullopt;
     K::Point_3 p;
-    if (const K::Point_3* q = boost::get<K::Point_3>(&h->first)) p = *q;
-    else if (const K::Segment_3* g = boost::get<K::Segment_3>(&h->first)) p = g->source();
-    else return std::nullopt;
+    if (const K::Point_3* q = boost::get<K::Point_3>(&h->first))
+      p = *q;
+    else if (const K::Segment_3* g = boost::get<K::Segment_3>(&h->first))
+      p = g->source();
+    else
+      return std::nullopt;
     const Vec3d P{CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
     return Hit{dot(P - r.o, r.d) / dot(r.d, r.d), int(h->second - s->tris.begin())};
   };
@@ -212,8 +216,8 @@ std::vector<Subject> named(const std::string& spec) {
     }
     const Method* m = find_method(method);
     if (!m || m->kind != Kind::triangle || (!prec.empty() && prec != "float" && prec != "double"))
-      throw std::invalid_argument("unknown tracer '" + spec + "'; known: " + known_names() + "; triangle methods: " +
-                                  method_names(Kind::triangle));
+      throw std::invalid_argument("unknown tracer '" + spec + "'; known: " + known_names() +
+                                  "; triangle methods: " + method_names(Kind::triangle));
   }
   std::vector<Subject> out;
   for (const Method& m : methods()) {
@@ -330,7 +334,8 @@ Report run(const std::vector<Subject>& subjects, const Options& opt) {
           } else if (mode == 1) {
             const auto& f = mesh.triangles[std::size_t(g.below(int(mesh.triangles.size())))];
             const int k = g.below(3);
-            const Vec3d a = mesh.positions[std::size_t(f[std::size_t(k)])], b = mesh.positions[std::size_t(f[std::size_t((k + 1) % 3)])];
+            const Vec3d a = mesh.positions[std::size_t(f[std::size_t(k)])],
+                        b = mesh.positions[std::size_t(f[std::size_t((k + 1) % 3)])];
             target = to_float32(a + (b - a) * g.uniform(0.05, 0.95));
           } else {
             target = o + g.unit() * scale;
@@ -339,8 +344,9 @@ Report run(const std::vector<Subject>& subjects, const Options& opt) {
           if (c.ray.d == Vec3d{0, 0, 0}) c.ray.d = to_float32(g.unit());
           double best = std::numeric_limits<double>::infinity(), last = -best;
           for (const auto& f : mesh.triangles) {
-            const oracle::Answer a = oracle::triangle(c.ray, mesh.positions[std::size_t(f[0])],
-                                                      mesh.positions[std::size_t(f[1])], mesh.positions[std::size_t(f[2])]);
+            const oracle::Answer a =
+                oracle::triangle(c.ray, mesh.positions[std::size_t(f[0])], mesh.positions[std::size_t(f[1])],
+                                 mesh.positions[std::size_t(f[2])]);
             if (a.verdict == oracle::Verdict::hit || a.verdict == oracle::Verdict::boundary) {
               best = std::min(best, a.t);
               last = std::max(last, a.t);

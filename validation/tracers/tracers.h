@@ -52,7 +52,7 @@ using IntersectFn = std::function<std::optional<Hit>(const Rayd&)>;
 using BuildFn = std::function<IntersectFn(const Mesh&)>;
 
 struct Subject {
-  std::string name;  // e.g. "bvh/moller/float", "embree", "mine"
+  std::string name;                      // e.g. "bvh/moller/float", "embree", "mine"
   Precision precision = Precision::f64;  // for the wrong-nearest bound
   BuildFn build;
 };

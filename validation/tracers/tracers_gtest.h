@@ -24,12 +24,12 @@ inline ::testing::AssertionResult IsLeakFree(const Subject& s, const Options& o 
   for (const Cell& c : r.cells)
     if (c.stats.leaks)
       bad << " " << c.shape << "@offset " << c.offset << " scale " << c.scale << ": " << c.stats.leaks << "/"
-          << c.stats.rays << " (inside miss rate " << double(c.stats.inside_leaks) / double(std::max<std::uint64_t>(1, c.stats.inside_rays))
-          << ", Embree's bar " << kEmbreeMissRate << ");";
-  if (bad.str().empty())
-    return ::testing::AssertionSuccess() << s.name << " did not leak on " << t.rays << " rays";
-  return ::testing::AssertionFailure() << s.name << " leaked " << t.leaks << " of " << t.rays << " rays (seed " << o.seed
-                                       << "):" << bad.str();
+          << c.stats.rays << " (inside miss rate "
+          << double(c.stats.inside_leaks) / double(std::max<std::uint64_t>(1, c.stats.inside_rays)) << ", Embree's bar "
+          << kEmbreeMissRate << ");";
+  if (bad.str().empty()) return ::testing::AssertionSuccess() << s.name << " did not leak on " << t.rays << " rays";
+  return ::testing::AssertionFailure() << s.name << " leaked " << t.leaks << " of " << t.rays << " rays (seed "
+                                       << o.seed << "):" << bad.str();
 }
 
 }  // namespace ra::tracers

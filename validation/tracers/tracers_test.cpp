@@ -63,24 +63,24 @@ TEST(Tracers, TheAssertionCatchesAUserTracerThatDropsHits) {
     if (best && best->prim == 0) return std::nullopt;
     return best;
   };
-  const Subject exact = tracer_subject<Loop>("exact-loop", Precision::f64, build, [&](const Loop& l, const Rayd& r) {
-    return intersect(l, r);
-  });
-  EXPECT_TRUE(IsLeakFree(tracer_subject<Loop>("exact", Precision::f64, build,
-                                              [&](const Loop& l, const Rayd& r) {
-                                                std::optional<Hit> best;
-                                                for (std::size_t i = 0; i < l.m.triangles.size(); ++i) {
-                                                  const auto& f = l.m.triangles[i];
-                                                  const oracle::Answer a = oracle::triangle(
-                                                      r, l.m.positions[std::size_t(f[0])], l.m.positions[std::size_t(f[1])],
-                                                      l.m.positions[std::size_t(f[2])]);
-                                                  if ((a.verdict == oracle::Verdict::hit || a.verdict == oracle::Verdict::boundary) &&
-                                                      (!best || a.t < best->t))
-                                                    best = Hit{a.t, int(i)};
-                                                }
-                                                return best;
-                                              }),
-                         small()));
+  const Subject exact = tracer_subject<Loop>("exact-loop", Precision::f64, build,
+                                             [&](const Loop& l, const Rayd& r) { return intersect(l, r); });
+  EXPECT_TRUE(IsLeakFree(
+      tracer_subject<Loop>("exact", Precision::f64, build,
+                           [&](const Loop& l, const Rayd& r) {
+                             std::optional<Hit> best;
+                             for (std::size_t i = 0; i < l.m.triangles.size(); ++i) {
+                               const auto& f = l.m.triangles[i];
+                               const oracle::Answer a =
+                                   oracle::triangle(r, l.m.positions[std::size_t(f[0])],
+                                                    l.m.positions[std::size_t(f[1])], l.m.positions[std::size_t(f[2])]);
+                               if ((a.verdict == oracle::Verdict::hit || a.verdict == oracle::Verdict::boundary) &&
+                                   (!best || a.t < best->t))
+                                 best = Hit{a.t, int(i)};
+                             }
+                             return best;
+                           }),
+      small()));
   const ::testing::AssertionResult r = IsLeakFree(exact, small());
   EXPECT_FALSE(r);
   EXPECT_NE(std::string(r.message()).find("exact-loop leaked"), std::string::npos) << r.message();
