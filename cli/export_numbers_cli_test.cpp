@@ -32,6 +32,7 @@ std::vector<std::vector<std::string>> rows(const fs::path& p) {
   std::istringstream in(slurp(p));
   std::string line;
   while (std::getline(in, line)) {
+    if (line.rfind("#", 0) == 0) continue;  // the export's stamp line
     std::vector<std::string> f;
     std::stringstream ss(line);
     std::string x;

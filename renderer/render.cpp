@@ -208,10 +208,14 @@ struct Tracer::Impl {
           meshes_scale = std::max(meshes_scale, m.scale);
         }
       };
-      if (opt.use_double)
-        each(meshes_d);
-      else
-        each(meshes_f);
+      // Not for the documents' angles and areas methods: they accept hits by
+      // absolute tolerances, far beyond the rounding of their triangles, so
+      // no padding covers them at any distance and moving their rays would
+      // only change the documents' own float answers (document 004's cube,
+      // seen from 600 units, takes its Heron NaN hits elsewhere).
+      const bool absolute_tolerance = tri_method->name == "angles" || tri_method->name == "areas";
+      if (!absolute_tolerance && opt.use_double) each(meshes_d);
+      if (!absolute_tolerance && !opt.use_double) each(meshes_f);
       if (meshes_scale > 0) {
         meshes_center = (lo + hi) * 0.5;
         meshes_radius = length(hi - lo) * 0.5;

@@ -24,7 +24,11 @@ if (process.argv.length !== 5) {
 const [threeDir, casesPath, answersPath] = process.argv.slice(2);
 const THREE = await import(pathToFileURL(join(threeDir, "build", "three.module.js")).href);
 
-const lines = readFileSync(casesPath, "utf8").split(/\r?\n/);
+// The export's first line is its stamp (# rayaudit-cases version=... seed=...):
+// comment lines are skipped, the first other line is the header.
+const lines = readFileSync(casesPath, "utf8")
+  .split(/\r?\n/)
+  .filter((l) => !l.startsWith("#"));
 const header = lines[0].split(",");
 const col = Object.fromEntries(header.map((name, i) => [name, i]));
 for (const name of ["id", "ox", "oy", "oz", "dx", "dy", "dz", "ax", "ay", "az", "bx", "by", "bz", "cx", "cy", "cz"]) {

@@ -101,7 +101,7 @@ TEST(Shrink, ReadableJsonIsShortAndTheSameScene) {
   const std::string text = readable_json(j);
   EXPECT_EQ(json::parse(text), j);
   auto count_lines = [](const std::string& t) { return int(std::count(t.begin(), t.end(), '\n')) + 1; };
-  EXPECT_LT(3 * count_lines(text), count_lines(j.dump(2))) << text;  // not one number per line
+  EXPECT_LT(2 * count_lines(text), count_lines(j.dump(2))) << text;  // not one number per line
   std::size_t longest = 0, start = 0;
   for (std::size_t i = 0; i <= text.size(); ++i)
     if (i == text.size() || text[i] == '\n') {
