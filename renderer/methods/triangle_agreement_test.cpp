@@ -76,7 +76,7 @@ TEST(TriangleAgreement, AllMethodsMatchConstructionFarFromEdges) {
   std::vector<const Method*> tri;
   for (const auto& m : methods())
     if (m.kind == Kind::triangle && !m.wrong_on_purpose) tri.push_back(&m);
-  ASSERT_EQ(tri.size(), 8u);
+  ASSERT_EQ(tri.size(), 9u);
   alignas(64) unsigned char pre[512];
   int failures = 0, hits = 0;
   for (int i = 0; i < kRays && failures < 10; ++i) {

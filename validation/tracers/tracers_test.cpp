@@ -95,7 +95,7 @@ TEST(Tracers, UnknownNamesListTheKnownOnes) {
       EXPECT_NE(std::string(e.what()).find("embree-robust"), std::string::npos) << e.what();
     }
   }
-  EXPECT_EQ(named("bvh").size(), 16u);  // 8 triangle methods, 2 precisions
+  EXPECT_EQ(named("bvh").size(), 18u);  // 9 triangle methods, 2 precisions
 }
 
 }  // namespace
