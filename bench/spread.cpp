@@ -1,5 +1,6 @@
 // Spread, calibration and the JSON of rayaudit-bench (spread.h).
 #include "spread.h"
+#include "io/json_input.h"
 
 #include <benchmark/benchmark.h>
 #include <sys/utsname.h>
@@ -51,35 +52,7 @@ Calibration calibration_us() {
   return best;
 }
 
-json parse_gbench(const std::string& in) {
-  std::string out;
-  out.reserve(in.size());
-  bool str = false;
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    const char c = in[i];
-    if (str) {
-      out += c;
-      if (c == '\\' && i + 1 < in.size())
-        out += in[++i];
-      else if (c == '"')
-        str = false;
-      continue;
-    }
-    if (c == '"') str = true;
-    bool replaced = false;
-    for (const char* tok : {"-Infinity", "Infinity", "NaN", "-nan", "nan", "-inf", "inf"}) {
-      const std::size_t n = std::strlen(tok);
-      if (in.compare(i, n, tok) == 0) {
-        out += "null";
-        i += n - 1;
-        replaced = true;
-        break;
-      }
-    }
-    if (!replaced) out += c;
-  }
-  return json::parse(out);
-}
+json parse_gbench(const std::string& in) { return json::parse(ra::gbench_non_finite_to_null(in)); }
 
 namespace {
 

@@ -16,6 +16,7 @@
 
 #include "io/atomic_file.h"
 #include "command.h"
+#include "io/json_input.h"
 #include "errors.h"
 #include "io/text_lines.h"
 #include "io/input_file.h"
@@ -48,40 +49,9 @@ std::string read_file(const fs::path& f) {
   return ss.str();
 }
 
-// Google Benchmark writes NaN and Infinity (e.g. the cv of a constant
-// counter), which JSON lacks: outside strings they become null, keeping lines.
-std::string gbench_non_finite_to_null(const std::string& in) {
-  std::string out;
-  bool str = false;
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    const char c = in[i];
-    if (str) {
-      out += c;
-      if (c == '\\' && i + 1 < in.size())
-        out += in[++i];
-      else if (c == '"')
-        str = false;
-      continue;
-    }
-    if (c == '"') str = true;
-    bool replaced = false;
-    for (const char* tok : {"-Infinity", "Infinity", "NaN", "-nan", "nan", "-inf", "inf"}) {
-      const std::size_t n = std::strlen(tok);
-      if (in.compare(i, n, tok) == 0) {
-        out += "null";
-        i += n - 1;
-        replaced = true;
-        break;
-      }
-    }
-    if (!replaced) out += c;
-  }
-  return out;
-}
-
 // Parses a JSON file; a syntax error names the file and line.
 json read_json(const fs::path& f, bool gbench = false) {
-  const std::string text = gbench ? gbench_non_finite_to_null(read_file(f)) : read_file(f);
+  const std::string text = gbench ? ra::gbench_non_finite_to_null(read_file(f)) : read_file(f);
   try {
     return json::parse(text);
   } catch (const json::parse_error& e) {

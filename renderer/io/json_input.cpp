@@ -1,5 +1,6 @@
 // A SAX front end to nlohmann's DOM parser (raw library messages,
 // the line of an overflowing number, duplicate keys accepted silently).
+#include <cstring>
 #include "json_input.h"
 
 #include <cstddef>
@@ -214,6 +215,35 @@ std::string json_error_text(const std::exception& e) {
   if (msg.rfind("key '", 0) == 0 && msg.size() > 15 && msg.compare(msg.size() - 11, 11, "' not found") == 0)
     return "needs \"" + msg.substr(5, msg.size() - 16) + "\"";
   return msg;
+}
+
+std::string gbench_non_finite_to_null(const std::string& in) {
+  std::string out;
+  bool str = false;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const char c = in[i];
+    if (str) {
+      out += c;
+      if (c == '\\' && i + 1 < in.size())
+        out += in[++i];
+      else if (c == '"')
+        str = false;
+      continue;
+    }
+    if (c == '"') str = true;
+    bool replaced = false;
+    for (const char* tok : {"-Infinity", "Infinity", "NaN", "-nan", "nan", "-inf", "inf"}) {
+      const std::size_t n = std::strlen(tok);
+      if (in.compare(i, n, tok) == 0) {
+        out += "null";
+        i += n - 1;
+        replaced = true;
+        break;
+      }
+    }
+    if (!replaced) out += c;
+  }
+  return out;
 }
 
 }  // namespace ra

@@ -31,4 +31,9 @@ nlohmann::json read_json_file(const std::string& file, JsonLines* lines = nullpt
 // "[json.exception.type_error.302]" prefix.
 std::string json_error_text(const std::exception& e);
 
+// Google Benchmark writes NaN and Infinity (e.g. the cv of a constant
+// counter), which JSON lacks: outside strings they become null, keeping
+// lines (so errors still name the right one).
+std::string gbench_non_finite_to_null(const std::string& text);
+
 }  // namespace ra

@@ -3,9 +3,10 @@
 // IsNoWorseThan in exact/audit_gtest.h), and what each failing family
 // teaches (its case ids, the command that replays them, a one-sided hint).
 //
-// Source: issue 31 of this repository (a user's gate written as a script
-// comparing CSV cells), and validation/exact/README.md for what the counts
-// mean. Guarantee: two runs are compared only when they judged the same
+// Why: a yes/no watertightness check cannot gate an intersector that was
+// never watertight; users wrote scripts comparing CSV cells to ask "no
+// worse than last release". validation/exact/README.md says what the
+// counts mean. Guarantee: two runs are compared only when they judged the same
 // rays (same rayaudit version, seed, rays per family, families and sweep
 // values, and the same number of tests in every cell); otherwise Mismatch
 // says which of these differs. Counts are deterministic for a seed, so a

@@ -2,7 +2,7 @@
 // to CI: the failure lines (case ids, replay command, hints), the
 // comparison with --baseline, and the --junit file. Shared by the plain
 // audit, --grade and `audit diff`, so all three say the same in the same
-// words. Source: issue 31 (CI gates for users' intersectors).
+// words, in a terminal and in a CI system's JUnit view.
 #pragma once
 #include <nlohmann/json.hpp>
 #include <optional>
