@@ -626,3 +626,48 @@ TEST(AuditExportCli, StreamedExportOnAFullDiskKeepsTheOldFile) {
 }
 
 }  // namespace
+
+namespace {
+
+// --tracers: whole tracers graded beside the kernels, into the same JSON.
+// Our BVH on the watertight method and Embree's robust mode do not leak on
+// closed meshes (renderer/accel/README.md, validation/tracers/README.md).
+TEST(AuditCli, TracersAreGradedIntoTheSameJson) {
+  const fs::path json = tmp("tracers.json");
+  fs::remove(json);
+  const Result r = rayaudit(
+      "audit --methods moller --families random --rays 1000 --precision float --tracers "
+      "bvh:watertight/double,embree-robust --tracer-rays 40 --json " +
+      json.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("bvh/watertight/double"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(slurp(json));
+  ASSERT_TRUE(j.contains("tracers")) << j.dump().substr(0, 400);
+  EXPECT_EQ(j["tracers"]["subjects"], (nlohmann::json{"bvh/watertight/double", "embree-robust"}));
+  ASSERT_FALSE(j["tracers"]["cells"].empty());
+  for (const auto& c : j["tracers"]["cells"]) {
+    EXPECT_GT(c["rays"].get<long long>(), 0) << c.dump();
+    EXPECT_EQ(c["leaks"], 0) << c.dump();
+  }
+}
+
+// Where tracers would be left out, or graded per shard and lost by the
+// merge, the option is refused before any work, and nothing is written.
+TEST(AuditCli, TracersWithCasesExportOrShardAreRefused) {
+  const fs::path cases = tmp("tracers_cases.csv"), out = tmp("tracers_refused.json");
+  write(cases, kHeader + "0,0,-1,0,0,1,-1,-1,0,1,-1,0,0,1,0\n");
+  fs::remove(out);
+  for (const std::string& extra : {"--cases " + cases.string() + " --methods moller", "--export-cases " + out.string(),
+                                   "--methods moller --shard 1/2 --json " + out.string()}) {
+    const Result r = rayaudit("audit --tracers bvh " + extra);
+    EXPECT_EQ(r.code, 2) << extra << "\n" << r.out << r.err;
+    EXPECT_NE(r.err.find("--tracers"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << extra;
+  }
+  const Result r = rayaudit("audit --methods moller --tracer-rays 10 --json " + out.string());
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("--tracer-rays"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace

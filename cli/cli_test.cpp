@@ -97,6 +97,21 @@ TEST(Cli, MethodsJsonListsNineTriangleFourSphereAndOnePlaneMethod) {
   EXPECT_EQ(by_kind.size(), 3u);
 }
 
+// The table names, after the registry, the peers the audit grades by name
+// and the whole tracers --tracers takes; the JSON above stays the registry.
+TEST(Cli, MethodsTableAlsoNamesPeersAndTracers) {
+  const auto r = ra::test::run_rayaudit("methods");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto peers_at = r.out.find("PEERS"), tracers_at = r.out.find("TRACERS");
+  ASSERT_NE(peers_at, std::string::npos) << r.out;
+  ASSERT_NE(tracers_at, std::string::npos) << r.out;
+  EXPECT_GT(peers_at, r.out.find("watertight"));
+  for (const char* peer : {"\nembree ", "\nembree-robust ", "\ncgal-epick "})
+    EXPECT_NE(r.out.find(peer, peers_at), std::string::npos) << peer << "\n" << r.out;
+  for (const char* tracer : {"bvh", "embree-robust", "cgal-aabb"})
+    EXPECT_NE(r.out.find(tracer, tracers_at), std::string::npos) << tracer;
+}
+
 // Every method by name, in both precisions, with culling: each render
 // succeeds and writes an image of the asked size in which something was hit
 // (not one uniform colour). Triangle methods render the doc002 tetrahedron

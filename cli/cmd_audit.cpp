@@ -801,6 +801,19 @@ void setup(CLI::App& app) {
     if (!a->export_cases.empty() && (!a->baseline.empty() || !a->junit.empty()))
       throw ra::InputError("audit: --export-cases writes only the cases CSV: drop --baseline/--junit");
     a->precision_given = cmd->count("--precision") > 0;
+    // Whole tracers are graded on their own generated meshes beside a full
+    // (unsharded) audit; with given cases, an export or a shard they would be
+    // silently left out, or graded once per shard and lost by the merge.
+    if (cmd->count("--tracer-rays") && a->tracers.empty())
+      throw ra::InputError("audit: --tracer-rays sets the rays of --tracers: add --tracers NAMES or drop it");
+    if (!a->tracers.empty())
+      for (const auto& [opt, given] : {std::pair<const char*, bool>{"--cases", !a->cases.empty()},
+                                       {"--export-cases", !a->export_cases.empty()},
+                                       {"--shard", !a->shard.empty()}})
+        if (given)
+          throw ra::InputError(std::string("audit: --tracers grades whole tracers in an audit of generated "
+                                           "families, unsharded; it does not go with ") +
+                               opt + ": run it separately");
     // Given cases are not generated: the generator's options would be ignored.
     if (!a->cases.empty())
       for (const char* opt : {"--rays", "--seed", "--families"})

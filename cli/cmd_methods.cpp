@@ -4,7 +4,9 @@
 #include <nlohmann/json.hpp>
 
 #include "command.h"
+#include "peers/peers.h"
 #include "registry.h"
+#include "tracers/tracers.h"
 
 namespace {
 
@@ -43,6 +45,14 @@ void setup(CLI::App& app) {
       std::printf("%-18s %-8s %-9s %s%s\n", m.name.c_str(), std::string(ra::kind_name(m.kind)).c_str(), pre,
                   pad(m.source, 47).c_str(), m.description.c_str());
     }
+    // Not registry methods (the JSON lists only those), but names the audit
+    // takes too: peers in --methods, whole tracers in --tracers.
+    std::printf("\nPEERS (audit --methods NAME; graded on the same cases)\n");
+    for (const auto& p : ra::peers::peers())
+      std::printf("%-18s %-8s %s%s\n", p.name.c_str(), ra::audit::precision_name(p.precision), p.info.what.c_str(),
+                  p.missing.empty() ? "" : (" [not in this build: " + p.missing + "]").c_str());
+    std::printf("\nTRACERS (audit --tracers NAMES; whole tracers on closed meshes)\n%s\n",
+                ra::tracers::known_names().c_str());
   });
 }
 

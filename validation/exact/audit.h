@@ -55,9 +55,10 @@ struct SphereSubject {
   std::string name() const { return method + "/" + precision_name(precision); }
 };
 
-template <class T, class F>
-TriangleSubject triangle_subject(std::string method, F&& f) {
-  TriangleSubject s;
+// A subject of either kind from one callable: its precision is T's.
+template <class Subject, class T, class F>
+Subject subject_of(std::string method, F&& f) {
+  Subject s;
   s.method = std::move(method);
   if constexpr (sizeof(T) == sizeof(float))
     s.precision = Precision::f32, s.f32 = std::forward<F>(f);
@@ -66,14 +67,12 @@ TriangleSubject triangle_subject(std::string method, F&& f) {
   return s;
 }
 template <class T, class F>
+TriangleSubject triangle_subject(std::string method, F&& f) {
+  return subject_of<TriangleSubject, T>(std::move(method), std::forward<F>(f));
+}
+template <class T, class F>
 SphereSubject sphere_subject(std::string method, F&& f) {
-  SphereSubject s;
-  s.method = std::move(method);
-  if constexpr (sizeof(T) == sizeof(float))
-    s.precision = Precision::f32, s.f32 = std::forward<F>(f);
-  else
-    s.precision = Precision::f64, s.f64 = std::forward<F>(f);
-  return s;
+  return subject_of<SphereSubject, T>(std::move(method), std::forward<F>(f));
 }
 
 // A registered method at one precision (two-sided: cull = false).

@@ -562,8 +562,9 @@ double round_ratio(Scratch& s, const Z& num, const Z& den) {
   return d;
 }
 
-// t = N / D exactly rounded, for a crossing the filter already certified.
-double exact_t(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+// The inputs as integers over one common power of two (exact), and the
+// triangle's normal n = (b - a) x (c - a) from them, in the thread's scratch.
+Scratch& scaled_with_normal(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   Scratch& s = scratch();
   const int E =
       common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
@@ -571,6 +572,12 @@ double exact_t(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   set_scaled(s.a, a, E), set_scaled(s.b, b, E), set_scaled(s.c, c, E);
   sub(s.e1, s.b, s.a), sub(s.e2, s.c, s.a);
   cross(s.n, s.e1, s.e2, s.t0);
+  return s;
+}
+
+// t = N / D exactly rounded, for a crossing the filter already certified.
+double exact_t(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  Scratch& s = scaled_with_normal(r, a, b, c);
   sub(s.ao, s.a, s.o);
   dot(s.D, s.n, s.d, s.t0);
   dot(s.N, s.n, s.ao, s.t0);
@@ -580,13 +587,7 @@ double exact_t(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
 
 Answer exact_triangle(const Rayd& r, const Vec3d& a, const Vec3d& b, const Vec3d& c, double lo) {
   ++g_fallbacks;
-  Scratch& s = scratch();
-  const int E =
-      common_exponent({r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
-  set_scaled(s.o, r.o, E), set_scaled(s.d, r.d, E);
-  set_scaled(s.a, a, E), set_scaled(s.b, b, E), set_scaled(s.c, c, E);
-  sub(s.e1, s.b, s.a), sub(s.e2, s.c, s.a);
-  cross(s.n, s.e1, s.e2, s.t0);
+  Scratch& s = scaled_with_normal(r, a, b, c);
   if (s.n.x.sign() == 0 && s.n.y.sign() == 0 && s.n.z.sign() == 0) return make(Verdict::degenerate);
   sub(s.ao, s.a, s.o), sub(s.bo, s.b, s.o), sub(s.co, s.c, s.o);
   dot(s.D, s.n, s.d, s.t0);
