@@ -319,8 +319,8 @@ def chart_speed_accuracy(entries, methods, have_bench):
                                  "Sphere methods: speed against wrong answers")
             perf.stamp(fig, STAMP[0])
             CHART_FACTS.append(perf.axis_facts(ax, "speed_wrong_spheres", labels=perf.place_labels(fig, ax, labs)))
-            charts.append((svg_of(fig), "Sphere methods over the sphere families (huge, tiny-far, near-origin, refracted); "
-                           "same reading as above."))
+            charts.append((svg_of(fig), "Sphere methods over the sphere families (huge, tiny-far, near-origin, "
+                           "refracted); same reading as above."))
     else:
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
         for ax, field, title in ((axes[0], "wrong_pct", "wrong % of tests"),
