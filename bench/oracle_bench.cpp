@@ -112,7 +112,9 @@ void BM_Sphere(benchmark::State& state, const Family* f, int threads) {
 void register_oracle() {
   for (const Family& f : families())
     for (int t : thread_counts()) {
-      const std::string name = "oracle/" + f.name + "/threads=" + std::to_string(t);
+      // A name two families share (refracted) names the sphere one apart.
+      const std::string family = find_family(f.name) == &f ? f.name : f.name + "-sphere";
+      const std::string name = "oracle/" + family + "/threads=" + std::to_string(t);
       const Family* fp = &f;
       std::function<void(benchmark::State&)> fn;
       if (f.kind == ra::Kind::sphere)

@@ -15,7 +15,9 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -623,6 +625,61 @@ TEST(AuditExportCli, StreamedExportOnAFullDiskKeepsTheOldFile) {
   EXPECT_TRUE(one_line(r.err)) << r.err;
   EXPECT_NE(r.err.find(out.string() + ": cannot write"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(out), "good");
+}
+
+// --families refracted: one name, a triangle and a sphere family, so every
+// method of the registry is graded, in both precisions, under each of the
+// four strategies at each of the four scales.
+TEST(AuditCli, RefractedGradesEveryMethodAndStrategy) {
+  const fs::path json = tmp("refracted.json");
+  const Result r = rayaudit("audit --families refracted --rays 160 --json " + json.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(json));
+  std::size_t methods = 0;
+  for (const auto& m : ra::methods()) methods += m.kind == ra::Kind::triangle || m.kind == ra::Kind::sphere;
+  ASSERT_EQ(j["subjects"].size(), 2 * methods);
+  EXPECT_EQ(j["cells"].size(), 2 * methods * 16);
+  std::map<std::string, std::set<std::string>> sweeps;
+  std::map<std::string, std::uint64_t> spawned;
+  for (const auto& c : j["cells"]) {
+    EXPECT_EQ(c["family"], "refracted");
+    EXPECT_TRUE(c["stats"].contains("skipped_walls")) << c.dump();
+    sweeps[c["subject"]].insert(c["sweep"].get<std::string>());
+    spawned[c["subject"]] += c["stats"]["spawned"].get<std::uint64_t>();
+  }
+  for (const auto& s : j["subjects"]) {
+    const std::string name = s["name"];
+    EXPECT_EQ(sweeps[name].size(), 16u) << name;
+    for (const char* st : {"eps", "pov", "normal-offset", "ulp-offset"})
+      for (const char* sc : {"1e-08", "0.0001", "1", "10000"})
+        EXPECT_TRUE(sweeps[name].count(std::string(st) + "@" + sc)) << name << " " << st << "@" << sc;
+    EXPECT_GT(spawned[name], 0u) << name;
+  }
+  // The text table: a row per kind, precision and strategy.
+  for (const char* kind : {"triangle", "sphere"})
+    for (const char* prec : {"float", "double"})
+      for (const char* st : {"eps", "pov", "normal-offset", "ulp-offset"}) {
+        char row[64];
+        std::snprintf(row, sizeof row, "%-9s %-7s %-14s", kind, prec, st);
+        EXPECT_NE(r.out.find(row), std::string::npos) << row << "\n" << r.out;
+      }
+}
+
+// The name a sphere method alone grades (the triangle family of that name
+// has no subject), and a misspelt one refused in one line.
+TEST(AuditCli, RefractedWithSphereMethodsOnlyAndAMisspeltFamily) {
+  const fs::path json = tmp("refracted-sphere.json");
+  const Result r = rayaudit("audit --methods kraus --families refracted --rays 64 --json " + json.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(json));
+  ASSERT_EQ(j["subjects"].size(), 2u);
+  EXPECT_EQ(j["subjects"][0]["kind"], "sphere");
+  EXPECT_EQ(j["cells"].size(), 2u * 16u);
+  const Result bad = rayaudit("audit --families refracted,refraction --rays 64");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(one_line(bad.err)) << bad.err;
+  EXPECT_NE(bad.err.find("unknown family 'refraction'"), std::string::npos) << bad.err;
+  EXPECT_EQ(bad.err.find("refracted, refracted"), std::string::npos) << "each name listed once: " << bad.err;
 }
 
 }  // namespace

@@ -455,9 +455,10 @@ void export_cases(const Args& a) {
       throw ra::InputError("audit: --export-cases: '" + name +
                            "' is a sphere family; the cases CSV holds rays and triangles only");
     if (f->secondary)
-      throw ra::InputError(
-          "audit: --export-cases: 'secondary' has no fixed cases (its rays start at each method's own "
-          "hit point); audit it with --families secondary");
+      throw ra::InputError("audit: --export-cases: '" + name +
+                           "' has no fixed cases (its rays start at each method's own hit point); audit it with "
+                           "--families " +
+                           name);
   }
   if (fams.empty())
     for (const Family& f : families())
@@ -554,8 +555,12 @@ void audit(const Args& a) {
   if (!a.families.empty()) {
     // A family graded by none of the chosen methods would be an empty table.
     for (const auto& name : opt.families) {
-      const Family* f = find_family(name);
-      const bool graded = f->kind == ra::Kind::triangle ? !tris.empty() : !spheres.empty();
+      // A name of both kinds (refracted) is graded by either kind of method.
+      const auto named = ra::audit::families_named(name);
+      const Family* f = named[0];
+      const bool graded = std::any_of(named.begin(), named.end(), [&](const Family* g) {
+        return g->kind == ra::Kind::triangle ? !tris.empty() : !spheres.empty();
+      });
       if (!graded)
         throw ra::InputError("audit: family '" + name + "' is a " +
                              (f->kind == ra::Kind::triangle ? "triangle" : "sphere") + " family, but no " +

@@ -94,6 +94,31 @@ TEST(ReportCli, AcceptsGoogleBenchmarksNaN) {
   fs::remove_all(d);
 }
 
+// The stability section's refracted rays: a chart and a table with a row
+// per kind, precision and strategy, whose spawned counts are the audit's.
+TEST(ReportCli, StabilityShowsRefractedRaysPerStrategyAndScale) {
+  const fs::path d = fresh_dir("refracted");
+  const fs::path a = d / "audit.json";
+  ASSERT_EQ(run_rayaudit("audit --methods moller,kraus --families refracted --rays 160 --json " + a.string()).code, 0);
+  const auto r = report(d, "--audit " + a.string());
+  ASSERT_EQ(r.code, 0) << r.all;
+  const std::string html = slurp(d / "rep" / "index.html");
+  EXPECT_NE(html.find("<h3>refracted</h3>"), std::string::npos);
+  EXPECT_NE(html.find("self-hit % / skipped %"), std::string::npos);
+  const auto rep = nlohmann::json::parse(slurp(d / "rep" / "report.json"));
+  ASSERT_EQ(rep["refracted"].size(), 2u * 2u * 4u);  // kinds x precisions x strategies
+  std::uint64_t in_report = 0, in_audit = 0;
+  for (const auto& row : rep["refracted"]) {
+    EXPECT_EQ(row["scales"].size(), 4u) << row.dump();
+    for (const auto& e : row["scales"]) in_report += e["spawned"].get<std::uint64_t>();
+  }
+  const auto audit = nlohmann::json::parse(slurp(a));
+  for (const auto& c : audit["cells"]) in_audit += c["stats"]["spawned"].get<std::uint64_t>();
+  EXPECT_GT(in_audit, 0u);
+  EXPECT_EQ(in_report, in_audit);
+  fs::remove_all(d);
+}
+
 // A figure the page draws must be a finite number >= 0: NaN or Infinity
 // outside a cv/stddev row, or a negative time, is one line and exit 2 (the
 // page drew nothing, or a point off the chart, with matplotlib's warnings).

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "shading/glass.h"
 #include "spawn.h"
 #include "workers.h"
 
@@ -101,7 +102,7 @@ void Stats::merge(const Stats& o) {
   add(degenerate_hits, o.degenerate_hits), add(degenerate_misses, o.degenerate_misses);
   add(nan_inf, o.nan_inf), add(wrong_t, o.wrong_t);
   add(groups, o.groups), add(leaks, o.leaks), add(double_hits, o.double_hits);
-  add(spawned, o.spawned), add(self_hits, o.self_hits);
+  add(spawned, o.spawned), add(self_hits, o.self_hits), add(skipped_walls, o.skipped_walls);
   add(t_samples, o.t_samples);
   max_ulps = std::max(max_ulps, o.max_ulps);
   max_rel = std::max(max_rel, o.max_rel);
@@ -150,6 +151,7 @@ nlohmann::json Stats::to_json() const {
                       {"double_hits", double_hits},
                       {"spawned", spawned},
                       {"self_hits", self_hits},
+                      {"skipped_walls", skipped_walls},
                       {"t_samples", t_samples},
                       {"t_ulps_median", median_ulps()},
                       {"t_ulps_max", max_ulps},
@@ -176,33 +178,13 @@ namespace {
 // invariants are those book() keeps: each test counted under exactly one
 // verdict, and every part no larger than its whole.
 void check_merged_stats(const nlohmann::json& j, const nlohmann::json& h, const Stats& s) {
-  static const std::set<std::string> stats_keys = {"tests",
-                                                   "wrong",
-                                                   "wrong_pct",
-                                                   "true_hits",
-                                                   "false_hits",
-                                                   "true_misses",
-                                                   "false_misses",
-                                                   "boundary_hits",
-                                                   "boundary_misses",
-                                                   "coplanar_hits",
-                                                   "coplanar_misses",
-                                                   "degenerate_hits",
-                                                   "degenerate_misses",
-                                                   "nan_inf",
-                                                   "wrong_t",
-                                                   "groups",
-                                                   "leaks",
-                                                   "double_hits",
-                                                   "spawned",
-                                                   "self_hits",
-                                                   "t_samples",
-                                                   "t_ulps_median",
-                                                   "t_ulps_max",
-                                                   "t_rel_median",
-                                                   "t_rel_max",
-                                                   "back_hits",
-                                                   "back_false_misses"};
+  static const std::set<std::string> stats_keys = {
+      "tests",           "wrong",           "wrong_pct",         "true_hits",       "false_hits",
+      "true_misses",     "false_misses",    "boundary_hits",     "boundary_misses", "coplanar_hits",
+      "coplanar_misses", "degenerate_hits", "degenerate_misses", "nan_inf",         "wrong_t",
+      "groups",          "leaks",           "double_hits",       "spawned",         "self_hits",
+      "skipped_walls",   "t_samples",       "t_ulps_median",     "t_ulps_max",      "t_rel_median",
+      "t_rel_max",       "back_hits",       "back_false_misses"};
   for (const auto& [key, value] : j.items())
     if (!stats_keys.count(key)) throw std::runtime_error("stats: '" + key + "': unknown key");
   for (const auto& [key, value] : h.items())
@@ -224,6 +206,7 @@ void check_merged_stats(const nlohmann::json& j, const nlohmann::json& h, const 
   too_many("leaks", s.leaks, "groups", s.groups);
   too_many("double_hits", s.double_hits, "groups", s.groups);
   too_many("self_hits", s.self_hits, "spawned", s.spawned);
+  too_many("skipped_walls", s.skipped_walls, "spawned - self_hits", s.spawned - s.self_hits);
   too_many("back_false_misses", s.back_false_misses, "back_hits", s.back_hits);
   too_many("back_hits", s.back_hits, "true_hits + false_misses", s.true_hits + s.false_misses);
   if (j.contains("wrong") && (!j["wrong"].is_number_unsigned() || j["wrong"].get<std::uint64_t>() != s.wrong()))
@@ -251,6 +234,7 @@ Stats Stats::from_json(const nlohmann::json& j, const nlohmann::json& h) {
   // Written since the one-sided hint; absent from older files.
   if (j.contains("back_hits")) s.back_hits = u("back_hits");
   if (j.contains("back_false_misses")) s.back_false_misses = u("back_false_misses");
+  if (j.contains("skipped_walls")) s.skipped_walls = u("skipped_walls");  // since the refracted family
   if (!j.contains("t_rel_max") || !j["t_rel_max"].is_number())
     throw std::runtime_error("stats: 't_rel_max' is missing or not a number");
   s.max_rel = j["t_rel_max"].get<double>();
@@ -487,6 +471,192 @@ void eval_secondary(const TriangleSubject& s, SelfIntersection strategy, const T
   }
 }
 
+// A refracted probe as every subject of precision T spawns it: the
+// direction (Snell from air into glass, glass::refract as the renderer
+// computes it, in double, rounded to T as spawn_ray takes it), the
+// geometric normal handed to spawn_ray, and the answer the ray must find:
+// the far wall, as the ray from the exact entry point in that direction
+// first meets it. The same for every subject of T: only the spawned origin
+// is the subject's (its hit point and the strategy).
+template <class T>
+struct Refraction {
+  bool ok = false;
+  Vec3d entry;           // the exact entry point, rounded to double
+  Vec3<T> dir, n;        // n: outward
+  double t_far = 0;      // exact t of the far wall along {entry, dir}
+  std::vector<int> far;  // triangles met there (two or more at an edge or vertex)
+  double split = 0;      // spheres: the chord's midpoint; the entry root is below it
+};
+
+template <class T>
+bool refract_inward(const Vec3d& D, const Vec3d& outward, Refraction<T>& out) {
+  const auto r = glass::refract(D, dot(D, outward) < 0 ? outward : -outward, 1.0 / kRefractedIor);
+  if (!r) return false;
+  out.dir = Vec3<T>(normalize(*r));
+  out.n = Vec3<T>(outward);
+  return dot(Vec3d(out.dir), outward) < 0;
+}
+
+bool crosses(const oracle::Answer& a) {
+  return (a.verdict == oracle::Verdict::hit || a.verdict == oracle::Verdict::boundary) && a.t > 0;
+}
+
+// The far wall of the ray from out.entry along out.dir: the exact first
+// crossing of triangles [first, first + count) other than the entry.
+template <class T>
+void find_far_wall(const Tri* tris, int first, int count, int entry, Refraction<T>& out) {
+  const Rayd ideal{out.entry, Vec3d(out.dir)};
+  for (int k = first; k < first + count; ++k) {
+    if (k == entry) continue;
+    const Tri& t = tris[std::size_t(k)];
+    const oracle::Answer x = oracle::triangle(ideal, t.a, t.b, t.c);
+    if (!crosses(x) || (!out.far.empty() && x.t > out.t_far)) continue;
+    if (!out.far.empty() && x.t < out.t_far) out.far.clear();
+    out.t_far = x.t;
+    out.far.push_back(k);
+  }
+  out.ok = !out.far.empty();
+}
+
+template <class T>
+Refraction<T> refraction(const TriangleBatch& b, const Probe& p) {
+  Refraction<T> out;
+  const Tri& e = b.tris[std::size_t(p.entry)];
+  const oracle::Answer a = oracle::triangle(p.ray, e.a, e.b, e.c);
+  if (a.verdict != oracle::Verdict::hit) return out;
+  out.entry = p.ray.o + p.ray.d * a.t;
+  if (!refract_inward(normalize(p.ray.d), normalize(cross(e.b - e.a, e.c - e.a)), out)) return out;
+  find_far_wall(b.tris.data(), p.first, p.count, p.entry, out);
+  return out;
+}
+
+template <class T>
+Refraction<T> refraction(const SphereCase& c) {
+  Refraction<T> out;
+  const oracle::Answer a = oracle::sphere(c.ray, c.center, c.radius);
+  if (a.verdict != oracle::Verdict::hit) return out;
+  out.entry = c.ray.o + c.ray.d * a.t;
+  if (!refract_inward(normalize(c.ray.d), normalize(out.entry - c.center), out)) return out;
+  const Vec3d D(out.dir);
+  out.split = -dot(D, out.entry - c.center) / dot(D, D);
+  const oracle::Answer x =
+      oracle::sphere(Rayd{out.entry, D, out.split, std::numeric_limits<double>::infinity()}, c.center, c.radius);
+  out.ok = out.split > 0 && crosses(x);
+  out.t_far = x.t;
+  return out;
+}
+
+// Counts a refracted ray by where it went (the strategy's doing); its test
+// is booked apart, against the exact answer for the ray as spawned (the
+// method's doing), so a self-hit the exact ray also makes is not wrong.
+void count_refracted(Stats& st, bool self_hit, bool reached) {
+  ++st.spawned;
+  st.self_hits += self_hit;
+  st.skipped_walls += !self_hit && !reached;
+}
+
+// The nearest hit of spawned ray r over the mesh: the far wall (or a
+// neighbour of it that r, moved off the exact entry point by the strategy,
+// does cross: exactly judged), the entry triangle, or neither.
+template <class T>
+void grade_spawned(const TriangleFn<T>& f, const Tri* tris, int first, int count, int entry, const Refraction<T>& rf,
+                   const Ray<T>& r, Stats& st) {
+  int nearest = -1;
+  T t = 0;
+  for (int k = first; k < first + count; ++k) {
+    const Tri& w = tris[std::size_t(k)];
+    const auto h = f(r, cv<T>(w.a), cv<T>(w.b), cv<T>(w.c));
+    if (h && finite_hit(*h) && (nearest < 0 || h->t < t)) nearest = k, t = h->t;
+  }
+  const Rayd exact(r);
+  if (nearest >= 0) {
+    const Tri& w = tris[std::size_t(nearest)];
+    const oracle::Answer a = oracle::triangle(exact, w.a, w.b, w.c);
+    const bool far = std::find(rf.far.begin(), rf.far.end(), nearest) != rf.far.end();
+    count_refracted(st, nearest == entry, far || (nearest != entry && crosses(a)));
+    book<T>(st, a, true, true, t);
+    return;
+  }
+  // No hit: wrong if the ray as spawned does cross the far wall or the
+  // entry triangle in its window (the triangles it can meet first).
+  oracle::Answer a{};
+  for (int k : rf.far) {
+    const Tri& w = tris[std::size_t(k)];
+    if (const oracle::Answer x = oracle::triangle(exact, w.a, w.b, w.c); crosses(x)) a = x;
+  }
+  if (!crosses(a)) {
+    const Tri& w = tris[std::size_t(entry)];
+    a = oracle::triangle(exact, w.a, w.b, w.c);
+  }
+  count_refracted(st, false, false);
+  book<T>(st, a, false, false, T(0));
+}
+
+template <class T>
+void grade_refracted_in(Stats& st, const TriangleSubject& s, const std::vector<Tri>& tris, int entry,
+                        const Vec3d& entry_point, const Rayd& spawned) {
+  Refraction<T> rf;
+  rf.entry = entry_point;
+  rf.dir = Vec3<T>(spawned.d);
+  find_far_wall(tris.data(), 0, int(tris.size()), entry, rf);
+  if (!rf.ok) throw std::invalid_argument("grade_refracted: the ray from the entry point meets no other triangle");
+  grade_spawned<T>(fn<T>(s), tris.data(), 0, int(tris.size()), entry, rf, Ray<T>(spawned), st);
+}
+
+// Refracted rays from the subject's own hit on the entry triangle, spawned
+// inward under the strategy, tested against the whole closed mesh: the
+// nearest hit must be on the far wall.
+template <class T>
+void eval_refracted(const TriangleSubject& s, SelfIntersection strategy, const TriangleBatch& b,
+                    const std::vector<Refraction<T>>& rfs, Stats& st, ProbeNumbers number) {
+  const auto& f = fn<T>(s);
+  for (std::size_t pi = 0; pi < b.probes.size(); ++pi) {
+    const Probe& p = b.probes[pi];
+    const Refraction<T>& rf = rfs[pi];
+    if (!rf.ok) continue;
+    const std::uint64_t bad = st.bad();
+    const Tri& tri = b.tris[std::size_t(p.entry)];
+    const Vec3<T> A = cv<T>(tri.a), B = cv<T>(tri.b), C = cv<T>(tri.c);
+    const auto h = f(cr<T>(p.ray), A, B, C);
+    if (!h || !finite_hit(*h)) continue;
+    const Vec3<T> P = A * (T(1) - h->b1 - h->b2) + B * h->b1 + C * h->b2;
+    const Ray<T> r = spawn_ray(strategy, P, triangle_point_error(A, B, C, h->b1, h->b2), rf.n, rf.dir, false, T(0));
+    grade_spawned<T>(f, b.tris.data(), p.first, p.count, p.entry, rf, r, st);
+    if (st.bad() != bad) st.note_example(number(pi));
+  }
+}
+
+// Spheres: the refracted ray from the subject's own hit o + t d; its hit
+// must be the far root (beyond the chord's midpoint along the exact ray).
+template <class T>
+void eval_refracted_spheres(const SphereSubject& s, SelfIntersection strategy, const std::vector<SphereCase>& cs,
+                            const std::vector<Refraction<T>>& rfs, Stats& st, ProbeNumbers number) {
+  const auto& f = fn<T>(s);
+  for (std::size_t i = 0; i < cs.size(); ++i) {
+    const Refraction<T>& rf = rfs[i];
+    if (!rf.ok) continue;
+    const std::uint64_t bad = st.bad();
+    const Ray<T> primary = cr<T>(cs[i].ray);
+    const Vec3<T> C = cv<T>(cs[i].center);
+    const T R = T(cs[i].radius);
+    const auto h = f(primary, C, R);
+    if (!h || !finite_hit(*h)) continue;
+    const Vec3<T> P = primary.o + primary.d * h->t;
+    // The renderer's bound for a sphere hit (render.cpp, point_error).
+    const Vec3<T> err = sphere_point_error(Vec3<T>(P - C)) + abs(C) * ra::detail::gamma<T>(1);
+    const Ray<T> r = spawn_ray(strategy, P, err, rf.n, rf.dir, false, T(0));
+    const auto h2 = f(r, C, R);
+    const bool hit = h2 && finite_hit(*h2);
+    // Where the hit is along the exact ray: before the midpoint is the entry side.
+    const Vec3d D(rf.dir);
+    const double along = hit ? double(h2->t) + dot(Vec3d(r.o) - rf.entry, D) / dot(D, D) : 0;
+    const bool self_hit = hit && along < rf.split;
+    count_refracted(st, self_hit, hit && !self_hit);
+    book<T>(st, oracle::sphere(Rayd(r), cs[i].center, cs[i].radius), h2.has_value(), hit, h2 ? h2->t : T(0));
+    if (st.bad() != bad) st.note_example(number(i));
+  }
+}
+
 template <class T>
 void eval_spheres(const SphereSubject& s, const std::vector<SphereCase>& cs, const std::vector<oracle::Answer>& ans,
                   Stats& st, ProbeNumbers number) {
@@ -564,9 +734,7 @@ Plan plan(const std::vector<const Family*>& fams, long long rays, Shard shard) {
   for (std::size_t fi = 0; fi < fams.size(); ++fi) {
     const Family& f = *fams[fi];
     for (int s = 0; s < int(f.sweep.size()); ++s) {
-      SweepPlan sp{
-          &f,   fi, s, probes_per_sweep(f, s, rays), pl.tasks, 0, std::uint64_t(f.secondary ? 2 : f.tris_per_probe(s)),
-          false};
+      SweepPlan sp{&f, fi, s, probes_per_sweep(f, s, rays), pl.tasks, 0, std::uint64_t(f.tests_per_probe(s)), false};
       const auto chunks = std::uint64_t((sp.probes + kChunk - 1) / kChunk);
       sp.by_probe = shard.n > 1 && chunks < 4 * shard.n;
       std::uint64_t probes;
@@ -602,6 +770,13 @@ std::vector<oracle::Answer> judge(const TriangleBatch& b) {
 
 }  // namespace
 
+void grade_refracted(Stats& st, const TriangleSubject& s, const std::vector<Tri>& tris, int entry,
+                     const Vec3d& entry_point, const Rayd& spawned) {
+  if (entry < 0 || entry >= int(tris.size())) throw std::invalid_argument("grade_refracted: no such entry triangle");
+  s.precision == Precision::f32 ? grade_refracted_in<float>(st, s, tris, entry, entry_point, spawned)
+                                : grade_refracted_in<double>(st, s, tris, entry, entry_point, spawned);
+}
+
 void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given, int count,
                  bool closed) {
   // Float answers are judged on the inputs rounded to float, as the audit's
@@ -632,7 +807,7 @@ void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const
 }
 
 long long probes_per_sweep(const Family& f, int sweep, long long rays) {
-  const long long per = rays / (long long)f.sweep.size() / (f.secondary ? 2 : f.tris_per_probe(sweep));
+  const long long per = rays / (long long)f.sweep.size() / f.tests_per_probe(sweep);
   return std::max(1LL, per);
 }
 
@@ -674,15 +849,15 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
   // The CLI checks these with its own messages; the library's users (the
   // GoogleTest checks) get the same refusals.
   for (const std::string& name : opt.families) {
-    const Family* f = find_family(name);
-    if (!f) {
-      std::string all;
-      for (const Family& g : families()) all += (all.empty() ? "" : ", ") + g.name;
-      throw std::invalid_argument("audit: unknown family '" + name + "' (" + all + ")");
-    }
-    if (f->kind == Kind::triangle ? tris.empty() : spheres.empty())
+    const auto named = families_named(name);
+    if (named.empty()) throw std::invalid_argument("audit: unknown family '" + name + "' (" + family_names() + ")");
+    // A name of both kinds (refracted) grades whichever subjects are given.
+    const bool graded = std::any_of(named.begin(), named.end(), [&](const Family* f) {
+      return f->kind == Kind::triangle ? !tris.empty() : !spheres.empty();
+    });
+    if (!graded)
       throw std::invalid_argument("audit: family '" + name + "' grades " +
-                                  (f->kind == Kind::triangle ? "triangles" : "spheres") +
+                                  (named[0]->kind == Kind::triangle ? "triangles" : "spheres") +
                                   ", and no such subject is given");
   }
   if (opt.rays < 1 || opt.rays > 10000000000LL)
@@ -764,6 +939,12 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           std::vector<oracle::Answer> ans;
           std::vector<int> cross;
           std::vector<char> proper;
+          std::vector<Refraction<float>> rf32;
+          std::vector<Refraction<double>> rf64;
+          if (t.family->refracted)
+            for (const Probe& pr : b.probes)
+              p == Precision::f32 ? rf32.push_back(refraction<float>(b, pr))
+                                  : rf64.push_back(refraction<double>(b, pr));
           if (!t.family->secondary) {
             ans = judge(b);
             std::size_t pair = 0;
@@ -777,8 +958,11 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           for (std::size_t si = 0; si < tris.size(); ++si) {
             if (tris[si].precision != p) continue;
             Stats st;
-            if (t.family->secondary) {
-              const auto strategy = SelfIntersection(secondary_strategy(t.sweep));
+            const auto strategy = SelfIntersection(secondary_strategy(t.sweep));
+            if (t.family->refracted) {
+              p == Precision::f32 ? eval_refracted<float>(tris[si], strategy, b, rf32, st, number)
+                                  : eval_refracted<double>(tris[si], strategy, b, rf64, st, number);
+            } else if (t.family->secondary) {
               p == Precision::f32 ? eval_secondary<float>(tris[si], strategy, b, st, number)
                                   : eval_secondary<double>(tris[si], strategy, b, st, number);
             } else {
@@ -795,12 +979,23 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
           generate(*t.family, t.sweep, p, stream, t.count, cs);
           if (ch.sweep->by_probe) cs = keep_dealt(cs, ch.index, shard);
           std::vector<oracle::Answer> ans;
-          for (const auto& c : cs) ans.push_back(oracle::sphere(c.ray, c.center, c.radius));
+          std::vector<Refraction<float>> rf32;
+          std::vector<Refraction<double>> rf64;
+          for (const auto& c : cs)
+            if (!t.family->refracted)
+              ans.push_back(oracle::sphere(c.ray, c.center, c.radius));
+            else
+              p == Precision::f32 ? rf32.push_back(refraction<float>(c)) : rf64.push_back(refraction<double>(c));
           for (std::size_t si = 0; si < spheres.size(); ++si) {
             if (spheres[si].precision != p) continue;
             Stats st;
-            p == Precision::f32 ? eval_spheres<float>(spheres[si], cs, ans, st, number)
-                                : eval_spheres<double>(spheres[si], cs, ans, st, number);
+            const auto strategy = SelfIntersection(secondary_strategy(t.sweep));
+            if (t.family->refracted)
+              p == Precision::f32 ? eval_refracted_spheres<float>(spheres[si], strategy, cs, rf32, st, number)
+                                  : eval_refracted_spheres<double>(spheres[si], strategy, cs, rf64, st, number);
+            else
+              p == Precision::f32 ? eval_spheres<float>(spheres[si], cs, ans, st, number)
+                                  : eval_spheres<double>(spheres[si], cs, ans, st, number);
             results.emplace_back(cell_index(tris.size() + si, fi, t.sweep), st);
           }
         }
@@ -990,6 +1185,53 @@ std::string Report::summary_table() const {
   for (std::size_t i = 0; i < subjects.size(); ++i)
     if (const PeerInfo* p = peer(i))
       out += "peer " + subjects[i] + ": " + p->what + "; speed figure: " + p->speed_source + "\n";
+  return out + refracted_table();
+}
+
+std::string Report::refracted_table() const {
+  // (kind, precision, strategy) rows in the order met, scale columns.
+  struct Row {
+    std::string kind, precision, strategy;
+    std::vector<std::pair<std::string, Stats>> scales;
+  };
+  std::vector<Row> rows;
+  for (const Cell& c : cells) {
+    const Family* f = find_family(c.family);
+    if (!f || !f->refracted) continue;
+    const auto at = c.sweep_label.find('@');
+    const std::string& n = subjects[c.subject];
+    const std::string kind = c.subject < kinds.size() ? kinds[c.subject] : "", prec = n.substr(n.rfind('/') + 1);
+    const std::string strategy = c.sweep_label.substr(0, at),
+                      scale = at == std::string::npos ? "" : c.sweep_label.substr(at + 1);
+    auto row = std::find_if(rows.begin(), rows.end(), [&](const Row& r) {
+      return r.kind == kind && r.precision == prec && r.strategy == strategy;
+    });
+    if (row == rows.end()) row = rows.insert(rows.end(), Row{kind, prec, strategy, {}});
+    auto col = std::find_if(row->scales.begin(), row->scales.end(), [&](const auto& e) { return e.first == scale; });
+    if (col == row->scales.end()) col = row->scales.insert(row->scales.end(), {scale, Stats{}});
+    col->second.merge(c.stats);
+  }
+  if (rows.empty()) return "";
+  std::string out =
+      "\nrefracted rays (spawned into the solid from each method's own entry hit), summed over the methods of a kind "
+      "and precision\n(a method's own failures add to every strategy: per method in the JSON and the report):\n"
+      "SELF% / SKIP% of spawned rays per strategy and scale (SELF: nearest hit on the entry surface; SKIP: the far "
+      "wall missed or passed)\n";
+  out += fmt("%-9s %-7s %-14s", "KIND", "PREC", "STRATEGY");
+  for (const auto& [scale, st] : rows[0].scales) out += fmt(" %15s", ("@" + scale).c_str());
+  out += fmt(" %9s\n", "SPAWNED");
+  for (const Row& r : rows) {
+    out += fmt("%-9s %-7s %-14s", r.kind.c_str(), r.precision.c_str(), r.strategy.c_str());
+    std::uint64_t spawned = 0;
+    for (const auto& [scale, st] : r.scales) {
+      spawned += st.spawned;
+      auto pct = [&](std::uint64_t v) {
+        return st.spawned ? fmt("%.2f", 100.0 * double(v) / double(st.spawned)) : "-";
+      };
+      out += fmt(" %15s", (pct(st.self_hits) + " / " + pct(st.skipped_walls)).c_str());
+    }
+    out += fmt(" %9llu\n", (unsigned long long)spawned);
+  }
   return out;
 }
 

@@ -98,7 +98,13 @@ struct Stats {
   // more hits than the ray has distinct exact crossings (double hit).
   std::uint64_t groups = 0, leaks = 0, double_hits = 0;
   // Secondary rays: spawned, and how many hit the triangle they left.
-  std::uint64_t spawned = 0, self_hits = 0;
+  // Refracted rays (spawned into a closed solid) must reach the far wall: a
+  // self-hit is a nearest hit on the entry triangle (spheres: on the entry
+  // side of the chord's midpoint), a skipped wall a miss of everything or a
+  // nearest hit on a triangle the ray does not cross. Both are the
+  // strategy's outcome, not wrong answers: the method's answer for the ray
+  // as spawned is booked as a test like any other.
+  std::uint64_t spawned = 0, self_hits = 0, skipped_walls = 0;
   // t error of right hits: ulps in the subject's precision and relative.
   // Relative errors: bin 0 is exact, then 8 bins per octave from 2^-80 to
   // 2^64 (below 2^-80 counts in bin 1, above 2^64 in the last bin): double
@@ -189,6 +195,10 @@ struct Report {
   // Reads what to_json() wrote for a shard (throws std::runtime_error).
   static Report from_json(const nlohmann::json& j);
   std::string summary_table() const;
+  // The refracted cells summed over the methods of each kind and precision:
+  // self-hits and skipped walls per strategy (rows) and scale (columns), in
+  // % of the rays spawned; empty when no refracted cell is there.
+  std::string refracted_table() const;
   std::string to_csv() const;
 };
 
@@ -211,6 +221,20 @@ struct GivenAnswer {
 };
 void grade_probe(Stats& st, Precision p, const Rayd& ray, const Tri* tris, const GivenAnswer* given, int count,
                  bool closed);
+
+// One refracted ray graded as the refracted family grades it, for rays
+// spawned by hand (tests; a strategy of one's own): tris is a closed convex
+// mesh entered through tris[entry] at entry_point (the exact entry point,
+// rounded), spawned the ray a strategy made there going into the mesh (in
+// s's precision). The far wall is the first exact crossing, the entry
+// triangle left out, of the ray from entry_point along spawned.d. The
+// subject's nearest hit over the mesh counts as a self-hit (the entry
+// triangle), a skipped wall (nothing, or a triangle the ray does not cross)
+// or the wall, and books one test against the exact answer for the spawned
+// ray on that triangle (no hit: on the far wall, else the entry). Throws
+// std::invalid_argument when the ray from entry_point meets no other triangle.
+void grade_refracted(Stats& st, const TriangleSubject& s, const std::vector<Tri>& tris, int entry,
+                     const Vec3d& entry_point, const Rayd& spawned);
 
 // Every probe of a family with its exact answers, as the audit sees them
 // (for the export and for tests that check the families themselves).

@@ -1,6 +1,6 @@
 // Case families: random, edge, vertex, grazing, offset, distance, scale,
-// sliver, near-miss, degenerate, closed-mesh (Embree's WatertightTest placement), secondary; spheres huge, tiny-far,
-// near-origin.
+// sliver, near-miss, degenerate, closed-mesh (Embree's WatertightTest placement), secondary, refracted; spheres
+// huge, tiny-far, near-origin, refracted.
 #include "families.h"
 
 #include <array>
@@ -487,6 +487,41 @@ void secondary_case(Rng& g, int sweep, TriangleBatch& b) {
   add_single(b, t, aimed(g.in_cube(4) * s, aim));
 }
 
+// A primary ray entering a convex solid at `aim` on its surface, whose
+// outward normal there is n: from a point on n's side of the tangent plane
+// (at least 25 degrees above it), 0.5 to 4 `size` away. The solid lies
+// behind that plane, so nothing of it is met before `aim`.
+Rayd entering_ray(Rng& g, const Vec3d& aim, const Vec3d& n, double size) {
+  Vec3d u, w;
+  frame(n, u, w);
+  const double su = g.uniform(-2, 2);
+  const Vec3d v = normalize(n + u * su + w * g.uniform(-2, 2));
+  return aimed(aim + v * (size * g.uniform(0.5, 4)), aim);
+}
+
+// Refracted: a closed convex mesh (the closed-mesh family's sphere or cube)
+// of size about s at the secondary family's scales, centred within s of the
+// origin, and a primary ray from outside aimed strictly inside one of its
+// triangles (barycentrics >= 0.1), the entry; the engine refracts at each
+// method's own hit and spawns inward.
+void refracted_case(Rng& g, int sweep, TriangleBatch& b) {
+  const double lo = kSecondaryScales[std::size_t(sweep) % kSecondaryScales.size()];
+  const double s = g.log_uniform(lo, lo * 1e4);
+  const Mesh& m = closed_mesh(g.below(2));
+  const Vec3d centre = g.in_cube(0.5) * s;
+  const int first = int(b.tris.size());
+  for (const auto& f : m.f)
+    b.tris.push_back({m.v[std::size_t(f[0])] * (0.5 * s) + centre, m.v[std::size_t(f[1])] * (0.5 * s) + centre,
+                      m.v[std::size_t(f[2])] * (0.5 * s) + centre});
+  const int entry = first + g.below(int(m.f.size()));
+  const Tri& t = b.tris[std::size_t(entry)];
+  const double b1 = g.uniform(0.1, 0.8), b2 = g.uniform(0.1, 0.9 - b1);
+  const Vec3d aim = t.a + (t.b - t.a) * b1 + (t.c - t.a) * b2;
+  Probe p{entering_ray(g, aim, normalize(cross(t.b - t.a, t.c - t.a)), s), first, int(m.f.size()), true};
+  p.entry = entry;
+  b.probes.push_back(p);
+}
+
 }  // namespace
 
 std::vector<Tri> closed_mesh_triangles(int shape) {
@@ -498,7 +533,15 @@ std::vector<Tri> closed_mesh_triangles(int shape) {
 
 int secondary_strategy(int sweep) { return sweep / int(kSecondaryScales.size()); }
 
+int Family::tests_per_probe(int sweep_index) const {
+  // A refracted ray is tested against the whole mesh (or its sphere): each
+  // of those tests is a ray/primitive test, as the other families count.
+  if (secondary && !refracted) return 2;
+  return tris_per_probe(sweep_index);
+}
+
 int Family::tris_per_probe(int sweep_index) const {
+  if (refracted && kind == Kind::triangle) return int((closed_mesh(0).f.size() + closed_mesh(1).f.size()) / 2);
   if (name == "closed-mesh") return int(closed_mesh(sweep_index / 2).f.size());
   if (name == "edge") return 2;
   if (name == "vertex") return 6;  // 3..8, mean 5.5
@@ -509,8 +552,8 @@ const std::vector<Family>& families() {
   static const std::vector<Family> all = [] {
     std::vector<Family> f;
     auto add = [&](std::string name, Kind k, std::string param, std::vector<std::string> sweep, bool grouped = false,
-                   bool secondary = false) {
-      f.push_back({std::move(name), k, std::move(param), std::move(sweep), grouped, secondary});
+                   bool secondary = false, bool refracted = false) {
+      f.push_back({std::move(name), k, std::move(param), std::move(sweep), grouped, secondary, refracted});
     };
     add("random", Kind::triangle, "aim spread", {"0.5", "1", "2"});
     add("edge", Kind::triangle, "offset", labels(kOffsets), true);
@@ -528,9 +571,11 @@ const std::vector<Family>& families() {
     for (const auto& s : kStrategies)
       for (double sc : kSecondaryScales) sec.push_back(s + "@" + label(sc));
     add("secondary", Kind::triangle, "strategy@scale", sec, false, true);
+    add("refracted", Kind::triangle, "strategy@scale", sec, true, true, true);
     add("huge", Kind::sphere, "radius", labels(kHugeRadii));
     add("tiny-far", Kind::sphere, "distance/radius", labels(kFarDistances));
     add("near-origin", Kind::sphere, "origin to surface", labels(kNearDistances));
+    add("refracted", Kind::sphere, "strategy@scale", sec, false, true, true);
     return f;
   }();
   return all;
@@ -542,9 +587,23 @@ const Family* find_family(const std::string& name) {
   return nullptr;
 }
 
+const Family* find_family(const std::string& name, Kind kind) {
+  for (const auto& f : families())
+    if (f.name == name && f.kind == kind) return &f;
+  return nullptr;
+}
+
+std::vector<const Family*> families_named(const std::string& name) {
+  std::vector<const Family*> out;
+  for (const auto& f : families())
+    if (f.name == name) out.push_back(&f);
+  return out;
+}
+
 std::string family_names() {
   std::string s;
-  for (const auto& f : families()) s += (s.empty() ? "" : ", ") + f.name;
+  for (const auto& f : families())
+    if (find_family(f.name) == &f) s += (s.empty() ? "" : ", ") + f.name;
   return s;
 }
 
@@ -590,6 +649,8 @@ void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int
         degenerate_case(g, sweep, out);
       else if (f.name == "secondary")
         secondary_case(g, sweep, out);
+      else if (f.name == "refracted")
+        refracted_case(g, sweep, out);
       else
         throw std::logic_error("no triangle generator for family " + f.name);
     }
@@ -619,6 +680,15 @@ void generate(const Family& f, int sweep, Precision p, std::uint64_t stream, int
       c.center = g.unit() * kFarDistances[s];
       const Vec3d o = g.in_cube(1);
       c.ray = aimed(o, c.center + g.in_cube(1.5));
+    } else if (f.name == "refracted") {
+      // A sphere of radius about s at the secondary family's scales, centred
+      // within s of the origin, and a primary ray from outside entering it
+      // at a random point (see entering_ray).
+      const double lo = kSecondaryScales[s % kSecondaryScales.size()];
+      c.radius = g.log_uniform(lo, lo * 1e4);
+      c.center = g.in_cube(0.5) * c.radius;
+      const Vec3d n = g.unit();
+      c.ray = entering_ray(g, c.center + n * c.radius, n, c.radius);
     } else if (f.name == "near-origin") {
       // Origins at distance delta from the surface (inside or outside).
       c.radius = g.log_uniform(0.1, 10);

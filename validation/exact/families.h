@@ -27,6 +27,9 @@ struct Probe {
   // A closed mesh around the origin: every ray must leave through it, so it
   // is judged for leaks without the group_is_proper test.
   bool closed = false;
+  // Refracted family: the triangle of the group the primary ray enters
+  // through (the group is a closed convex mesh; -1 elsewhere).
+  int entry = -1;
 };
 
 struct TriangleBatch {
@@ -47,14 +50,24 @@ struct Family {
   std::vector<std::string> sweep;  // one label per sweep value
   bool grouped = false;            // probes hold several triangles
   bool secondary = false;          // spawned rays (handled by the audit engine)
+  bool refracted = false;          // spawned rays enter the solid (secondary is set too)
   // Triangles each probe tests, for turning a case budget into probes.
   int tris_per_probe(int sweep_index) const;
+  // Tests each probe counts for --rays: the 2 spawned rays of a secondary
+  // probe (reflection and shadow), otherwise its primitives (a refracted
+  // probe's one spawned ray is tested against every triangle of its mesh,
+  // 46 on average, though it books one test: its nearest hit).
+  int tests_per_probe(int sweep_index) const;
 };
 
-// All families, triangles first, in a fixed order.
+// All families, triangles first, in a fixed order. A name may stand for a
+// triangle and a sphere family both (`refracted`): --families NAME grades
+// every method with it.
 const std::vector<Family>& families();
-const Family* find_family(const std::string& name);
-std::string family_names();
+const Family* find_family(const std::string& name);  // the first of that name
+const Family* find_family(const std::string& name, Kind kind);
+std::vector<const Family*> families_named(const std::string& name);
+std::string family_names();  // each name once
 
 // A deterministic stream per (seed, family, sweep value, chunk): the same
 // cases whatever the thread count, shard or which other families run. The
@@ -77,7 +90,11 @@ bool group_is_proper(const Tri* tris, int count, const Vec3d& d);
 // triangles, radius 2), 1 the cube [-1, 1]^3 (12). Outward winding.
 std::vector<Tri> closed_mesh_triangles(int shape);
 
-// The secondary family's sweep index = strategy * scales + scale index.
+// The secondary family's sweep index = strategy * scales + scale index;
+// the refracted families share the sweep.
 int secondary_strategy(int sweep);
+
+// Refracted rays enter glass of this index of refraction from air.
+inline constexpr double kRefractedIor = 1.5;
 
 }  // namespace ra::audit

@@ -319,8 +319,8 @@ def chart_speed_accuracy(entries, methods, have_bench):
                                  "Sphere methods: speed against wrong answers")
             perf.stamp(fig, STAMP[0])
             CHART_FACTS.append(perf.axis_facts(ax, "speed_wrong_spheres", labels=perf.place_labels(fig, ax, labs)))
-            charts.append((svg_of(fig), "Sphere methods over the sphere families (huge, tiny-far, near-origin); "
-                           "same reading as above."))
+            charts.append((svg_of(fig), "Sphere methods over the sphere families (huge, tiny-far, near-origin, "
+                           "refracted); same reading as above."))
     else:
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
         for ax, field, title in ((axes[0], "wrong_pct", "wrong % of tests"),
@@ -364,8 +364,56 @@ def stability(audit):
             "spawned": s["spawned"],
             "self_hits": s["self_hits"],
             "self_hit_pct": (100.0 * s["self_hits"] / s["spawned"]) if s["spawned"] else None,
+            # Refracted rays only (absent from audits before the family).
+            "skipped_walls": s.get("skipped_walls", 0),
+            "skip_pct": (100.0 * s.get("skipped_walls", 0) / s["spawned"]) if s["spawned"] else None,
         })
     return out
+
+
+def refracted(audit):
+    """The refracted family summed over the methods of each kind and precision: per strategy and scale, the
+    spawned rays, self-hits and skipped far walls. [{kind, precision, strategy, scales: [{scale, spawned,
+    self_hits, skipped_walls}]}]"""
+    kind = {s["name"]: s.get("kind", "triangle") for s in audit.get("subjects", [])}
+    rows = {}
+    for c in audit["cells"]:
+        if c["family"] != "refracted":
+            continue
+        s = c["stats"]
+        strategy, _, scale = c["sweep"].partition("@")
+        key = (kind.get(c["subject"], "triangle"), c["subject"].rsplit("/", 1)[1], strategy)
+        row = rows.setdefault(key, {"kind": key[0], "precision": key[1], "strategy": strategy, "scales": {}})
+        e = row["scales"].setdefault(scale, {"scale": scale, "spawned": 0, "self_hits": 0, "skipped_walls": 0})
+        e["spawned"] += s["spawned"]
+        e["self_hits"] += s["self_hits"]
+        e["skipped_walls"] += s.get("skipped_walls", 0)
+    return [dict(r, scales=list(r["scales"].values())) for r in rows.values()]
+
+
+def refracted_table_html(rows):
+    """Section 2's table of refracted rays: a row per kind, precision and strategy, a column per scale."""
+    if not rows:
+        return ""
+    scales = list(dict.fromkeys(e["scale"] for r in rows for e in r["scales"]))
+    h = ['<table class="grid"><tr><th class="l">kind</th><th class="l">precision</th><th class="l">strategy</th>' +
+         "".join(f"<th>scale {esc(sc)}: self-hit % / skipped %</th>" for sc in scales) + "<th>spawned</th></tr>"]
+    for r in rows:
+        by = {e["scale"]: e for e in r["scales"]}
+        cells = []
+        for sc in scales:
+            e = by.get(sc)
+            if not e or not e["spawned"]:
+                cells.append("<td>-</td>")
+                continue
+            self_pct, skip_pct = 100.0 * e["self_hits"] / e["spawned"], 100.0 * e["skipped_walls"] / e["spawned"]
+            bad = ' class="bad"' if e["self_hits"] or e["skipped_walls"] else ""
+            cells.append(f"<td{bad}>{self_pct:.3g} / {skip_pct:.3g}</td>")
+        h.append(f'<tr><td class="l">{esc(r["kind"])}</td><td class="l">{esc(r["precision"])}</td>'
+                 f'<td class="l">{esc(r["strategy"])}</td>' + "".join(cells) +
+                 f"<td>{sum(e['spawned'] for e in r['scales'])}</td></tr>")
+    h.append("</table>")
+    return "".join(h)
 
 
 def line_panel(ax, rows, methods, field, sweeps, numeric):
@@ -400,6 +448,28 @@ def chart_stability(stab, methods):
         precisions = list(dict.fromkeys(r["precision"] for r in rows))
         secondary = any(r["spawned"] for r in rows)
         grouped = any(r["groups"] for r in rows)
+        if secondary and family == "refracted":
+            # One row of panels per strategy: self-hits and skipped walls, float and double.
+            strategies = list(dict.fromkeys(s.split("@")[0] for s in sweeps))
+            panels = [(p, f, what) for p in precisions
+                      for f, what in (("self_hit_pct", "self-hit %"), ("skip_pct", "skipped far wall %"))]
+            fig, axes = plt.subplots(len(strategies), len(panels), figsize=(4.2 * len(panels), 2.4 * len(strategies)),
+                                     squeeze=False, sharey=True)
+            for i, st in enumerate(strategies):
+                for j, (p, field, what) in enumerate(panels):
+                    rs = [dict(r, sweep=r["sweep"].split("@")[1]) for r in rows
+                          if r["precision"] == p and r["sweep"].split("@")[0] == st]
+                    sw = list(dict.fromkeys(r["sweep"] for r in rs))
+                    line_panel(axes[i][j], rs, methods, field, sw, True)
+                    axes[i][j].set_title(f"{st}, {p}: {what}")
+                    axes[i][j].set_xlabel("scale of the solid (log)")
+            peer_subjects.legend(axes[0])
+            caption = ("refracted: rays spawned into a closed mesh or a sphere from each method's own entry hit under "
+                       "each self-intersection strategy; a self-hit meets the entry surface again, a skipped wall "
+                       "misses the far wall (the strategy's window or offset passed it). Lower is better; 0 is the "
+                       "goal. The table below sums the methods.")
+            charts.append((family, svg_of(fig), caption))
+            continue
         if secondary:
             # strategy@scale: one row of panels per self-intersection strategy.
             strategies = list(dict.fromkeys(s.split("@")[0] for s in sweeps))
@@ -981,6 +1051,8 @@ def page(rep, charts, methods, uris):
         h.append('<p class="notice">No audit given: no stability sweeps.</p>')
     for family, svg, cap in charts["stability"]:
         h.append(f"<h3>{esc(family)}</h3>" + chart_html(svg, cap))
+        if family == "refracted":
+            h.append(refracted_table_html(rep["refracted"]))
 
     # ---- 3
     h.append("<h2>3. Crack maps</h2>")
@@ -1129,6 +1201,7 @@ def main():
         "have_audit": audit is not None,
         "speed_accuracy": speed_accuracy(audit, bench, methods, timings) if audit else [],
         "stability": stability(audit) if audit else {},
+        "refracted": refracted(audit) if audit else [],
         "crack_maps": crack_maps(cm, cm_dir) if cm else [],
         "crack_meshes": cm["meshes"] if cm else [],
         "crack_legend": cm["legend"] if cm else "",
