@@ -1064,6 +1064,10 @@ struct Tracer::Impl {
     s.p = ray.at(h.t);
     switch (o.kind) {
       case Object::Kind::sphere:
+        // normal-offset's bound (point_error) is pbrt's for a point on the
+        // sphere: move it there. The other strategies keep POV-Ray's o + t d.
+        if (opt.self_intersection == SelfIntersection::normal_offset)
+          s.p = reproject_onto_sphere(s.p, o.sphere.center, o.sphere.radius);
         s.ng = s.n = (s.p - o.sphere.center) / o.sphere.radius;
         s.material = &o.material;
         break;

@@ -149,9 +149,22 @@ Vec3<T> triangle_point_error(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& 
 
 // pbrt-v4's bound for a point computed as o + t d and reprojected onto a
 // sphere: gamma(5) * |p - center| componentwise, plus the centre's own size.
+// It holds only for the reprojected point (reproject_onto_sphere): o + t d
+// itself carries the error of the method's t, which no bound of this form
+// covers (a quadratic's root can lose many digits).
 template <class T>
 Vec3<T> sphere_point_error(const Vec3<T>& p) {
   return abs(p) * detail::gamma<T>(5);
+}
+
+// pbrt-v4's reprojection (Sphere::Intersect: pHit *= radius / Distance(pHit,
+// 0)): the hit point moved along its radius onto the sphere, so that its
+// error is sphere_point_error's, whatever the error of t was.
+template <class T>
+Vec3<T> reproject_onto_sphere(const Vec3<T>& p, const Vec3<T>& center, T radius) {
+  const Vec3<T> r = p - center;
+  const T len = length(r);
+  return len > T(0) ? center + r * (radius / len) : p;
 }
 
 }  // namespace ra

@@ -641,8 +641,11 @@ void eval_refracted_spheres(const SphereSubject& s, SelfIntersection strategy, c
     const T R = T(cs[i].radius);
     const auto h = f(primary, C, R);
     if (!h || !finite_hit(*h)) continue;
-    const Vec3<T> P = primary.o + primary.d * h->t;
-    // The renderer's bound for a sphere hit (render.cpp, point_error).
+    // The renderer's point and bound for a sphere hit (render.cpp, surface
+    // and point_error): normal-offset's bound holds for the point moved onto
+    // the sphere, so that strategy spawns from there.
+    const Vec3<T> at = primary.o + primary.d * h->t;
+    const Vec3<T> P = strategy == SelfIntersection::normal_offset ? reproject_onto_sphere(at, C, R) : at;
     const Vec3<T> err = sphere_point_error(Vec3<T>(P - C)) + abs(C) * ra::detail::gamma<T>(1);
     const Ray<T> r = spawn_ray(strategy, P, err, rf.n, rf.dir, false, T(0));
     const auto h2 = f(r, C, R);
