@@ -167,10 +167,12 @@ TEST(Baseline, OneSidedSubjectIsNamedAsSuch) {
   EXPECT_NE(m.find("looks one-sided"), std::string::npos) << m;
   EXPECT_NE(m.find("cases random:"), std::string::npos) << m;
   EXPECT_NE(m.find("replay: rayaudit audit --export-cases"), std::string::npos) << m;
-  // Two-sided, the same method has no such hint.
+  // Two-sided, the same method gives no wrong answer on these rays: culling
+  // alone made the failures the hint names. (Looking for the hint's absence
+  // in its message passed vacuously: a success's message is empty.)
   const ::testing::AssertionResult two =
       ra::audit::HasNoWrongAnswers(registry("moller"), {.families = {"random"}, .rays = 2000});
-  EXPECT_EQ(std::string(two.message()).find("one-sided"), std::string::npos) << two.message();
+  EXPECT_TRUE(two) << two.message();
 }
 
 // Failing case ids are the lowest probe numbers whatever the threads.
