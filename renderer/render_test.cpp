@@ -78,16 +78,10 @@ TEST(Intersect, PlaneFromBothSidesAndParallel) {
   auto below = tr.intersect({{3, -1, 0}, {0, 1, 0}});
   ASSERT_TRUE(below);
   EXPECT_DOUBLE_EQ(below->t, 2.0);
-  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {1, 0, 0}}));  // parallel
-  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {0, 1, 0}}));  // plane behind
-  EXPECT_FALSE(tr.intersect({{
-                                 0,
-                                 5,
-                                 0,
-                             },
-                             {0, -1, 0},
-                             0,
-                             3.9}));  // beyond tmax
+  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {1, 0, 0}}));           // parallel
+  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {0, 1, 0}}));           // plane behind
+  EXPECT_FALSE(tr.intersect({{0, 5, 0}, {0, -1, 0}, 0, 3.9}));  // the plane at t = 4: beyond tmax
+  EXPECT_TRUE(tr.intersect({{0, 5, 0}, {0, -1, 0}, 0, 4.1}));   // within it
 }
 
 TEST(Intersect, TriangleAndTheNearestObjectWins) {

@@ -583,10 +583,9 @@ TEST(ObjErrors, IndexErrorsNameTheFaceLine) {
             "t.obj:4: vertex index out of range '99999999999999999999'");
 }
 
-// The issue: "an index past the end (at the end of the file or at that line:
-// say which)". An index defined only after the face is a forward reference
-// (not allowed: say where it is defined); one never defined says how many
-// the whole file has.
+// An index past the end says which it is, so the user knows what to fix:
+// one defined only after the face is a forward reference (not allowed: say
+// where it is defined); one never defined says how many the whole file has.
 TEST(ObjErrors, ForwardReferenceAndNeverDefinedAreTold) {
   const std::string t = kTri;
   auto forward = [](int face_line, const char* kind, int index, int defined_line, int before) {

@@ -5,6 +5,7 @@
 #include "glass.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -97,7 +98,8 @@ TEST(GlassScene, KeysAreReadAndOutOfRangeValuesRefused) {
 }
 
 TEST(GlassScene, MtlDissolveIorAndIllumMapOntoTheMaterial) {
-  const auto dir = std::filesystem::temp_directory_path() / "rayaudit-glass-mtl";
+  // Named per process: the release and sanitizer suites may run at once.
+  const auto dir = std::filesystem::temp_directory_path() / ("rayaudit-glass-mtl-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "g.mtl") << "newmtl g\nKd 0.2 0.4 0.6\nKs 0.9 0.9 0.9\nTr 0.75\nNi 1.45\nillum 7\n"
                                << "newmtl t\nKd 1 0 0\nTf 1 0 0\nd 0.5\nillum 4\nNi 1.7\n";

@@ -142,9 +142,18 @@ TEST(Baseline, IsWatertightCanBeLimitedToSweepValues) {
   const ra::audit::CheckOptions near{.rays = 3000, .sweeps = {"0", "sphere@origin", "box@origin"}};
   const ::testing::AssertionResult all = ra::audit::IsWatertight(mt, {.rays = 3000});
   const ::testing::AssertionResult origin = ra::audit::IsWatertight(mt, near);
+  // Moller in float leaks on shared edges and vertices at every offset
+  // (seed 1, 3000 rays: at 0, 10 and 1000). Unlimited, the failure names the
+  // far offsets; limited to the origin it still fails, naming offset 0 only.
+  // (Checking only for "@1e7" passed vacuously: no message names it.)
   EXPECT_FALSE(all);
-  EXPECT_EQ(std::string(origin.message()).find("@1e7"), std::string::npos) << origin.message();
-  EXPECT_EQ(std::string(origin.message()).find("@sphere@embree"), std::string::npos) << origin.message();
+  const std::string a = all.message(), o = origin.message();
+  EXPECT_NE(a.find("edge@1000:"), std::string::npos) << a;
+  EXPECT_NE(a.find("vertex@10:"), std::string::npos) << a;
+  EXPECT_FALSE(origin);
+  EXPECT_NE(o.find("edge@0:"), std::string::npos) << o;
+  for (const char* far : {"edge@10:", "edge@1000:", "vertex@10:", "vertex@1000:"})
+    EXPECT_EQ(o.find(far), std::string::npos) << far << " in " << o;
   EXPECT_THROW(ra::audit::IsWatertight(mt, {.sweeps = {"1e8"}}), std::invalid_argument);
 }
 
@@ -158,10 +167,12 @@ TEST(Baseline, OneSidedSubjectIsNamedAsSuch) {
   EXPECT_NE(m.find("looks one-sided"), std::string::npos) << m;
   EXPECT_NE(m.find("cases random:"), std::string::npos) << m;
   EXPECT_NE(m.find("replay: rayaudit audit --export-cases"), std::string::npos) << m;
-  // Two-sided, the same method has no such hint.
+  // Two-sided, the same method gives no wrong answer on these rays: culling
+  // alone made the failures the hint names. (Looking for the hint's absence
+  // in its message passed vacuously: a success's message is empty.)
   const ::testing::AssertionResult two =
       ra::audit::HasNoWrongAnswers(registry("moller"), {.families = {"random"}, .rays = 2000});
-  EXPECT_EQ(std::string(two.message()).find("one-sided"), std::string::npos) << two.message();
+  EXPECT_TRUE(two) << two.message();
 }
 
 // Failing case ids are the lowest probe numbers whatever the threads.

@@ -72,9 +72,10 @@ constexpr int kRays = 4000;
 
 }  // namespace
 
-// The done-when: per-peer leaks and double hits (and every other
-// count, cell by cell) of `audit --methods PEERS` equal those of grading the
-// same peers' answers to the exported cases with --grade.
+// Two paths to the same verdicts: per-peer leaks and double hits (and every
+// other count, cell by cell) of `audit --methods PEERS` equal those of
+// grading the same peers' answers to the exported cases with --grade, so a
+// user grading their own answers gets what the audit would have said.
 TEST(PeerSubjects, AuditAgreesWithGradingThePeersAnswers) {
   std::string names;
   for (const auto& p : ra::peers::peers())

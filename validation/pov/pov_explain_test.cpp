@@ -5,6 +5,7 @@
 #include "pov_explain.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -147,8 +148,9 @@ TEST(PovExplain, NearlyEqualNormalsMakeAFlatTriangle) {
   } catch (const InputError&) {
     GTEST_SKIP() << "POV-Ray is not installed (Debian package povray)";
   }
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("rayaudit-near-normals-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  // Named per process: GoogleTest's random seed is 0 unless shuffling, so it
+  // named the same folder for the release and sanitizer suites run at once.
+  const auto dir = std::filesystem::temp_directory_path() / ("rayaudit-near-normals-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   {
     std::ofstream obj(dir / "tri.obj");
