@@ -663,7 +663,7 @@ struct Tracer::Impl {
           m, boxed, window.o, window.d, window.tmin, window.tmax,
           [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
             exact_simd::leaf4<kFma>(
-                lanes, m.xtri4[first / 4], (1 << count) - 1,
+                lanes, window.tmax, m.xtri4[first / 4], (1 << count) - 1,
                 [&](int l, exact::detail::Signs sg, double U, double V, double W, int s)
                     __attribute__((always_inline)) {
                       const std::size_t slot = first + std::uint32_t(l);
@@ -699,7 +699,7 @@ struct Tracer::Impl {
           m, boxed, r.o, r.d, r.tmin, r.tmax,
           [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
             exact_simd::leaf4<kFma>(
-                lanes, m.xtri4[first / 4], (1 << count) - 1,
+                lanes, r.tmax, m.xtri4[first / 4], (1 << count) - 1,
                 [&](int l, exact::detail::Signs sg, double U, double V, double W,
                     int s) __attribute__((always_inline)) {
                   // never culled: see closest()

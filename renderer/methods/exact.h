@@ -45,7 +45,8 @@
 //    exact t (at most 1 ulp from it), and correctly rounded (to nearest)
 //    whenever the filter's whole enclosure of t rounds to one value (float
 //    rays, computed in double: all but about 1 in 2^20; double rays, in long
-//    double: about 9 in 10) and always on the exact path (MPFR). The
+//    double: about 9 in 10), on the double-word stage and on the exact path
+//    (MPFR). The
 //    value is a deterministic function of the inputs (the same operations
 //    in the same order), so the direct and the prepared forms return the
 //    same bits (exact_test.cpp checks it).
@@ -94,24 +95,28 @@
 //   Pn_i = |e1_j e2_k| + |e1_k e2_j|; with the same accounting of computed
 //   magnitudes as above, errN = 16 u PN~, errD = 16 u PD~.
 //   With a = errN / |N~| <= 1/4 and b = errD / |D~| <= 1/4, t~ = fl(N~ / D~):
-//     |t / t~ - 1| <= (a + b + u) / ((1 - b)(1 - u)) <= 2 (a + b) + 3u,
-//   so t lies in [lo, hi] = t~ -+ |t~| (2 (a + b) + 16u): computing the
-//   width costs at most 4 roundings of a value <= 1.01 |t~| and lo, hi one
-//   each of a value <= 2|t~|, 4u + 2u + ... < 13u, covered by 16u - 3u.
-//   The window is decided when [lo, hi] lies inside it or outside it. Rounding to nearest is
-//   monotone, so when T(lo) == T(hi) every value in [lo, hi], t among them,
-//   rounds to that one T: t correctly rounded. Otherwise, when [lo, hi]
-//   lies strictly between the neighbours of q = T(t~), t does too: q is
-//   faithful. Otherwise, for double inputs, stage 2b (exact.cpp,
+//     |t / t~ - 1| <= (a + b + u + bu) / ((1 - b)(1 - u)) <= K (a + b + 2u),
+//   K = 2, or 1 + 2^-19 when a, b <= 2^-20 (almost always). The certificate
+//   (beside enclose_t) multiplies through by |D~| instead of dividing, and
+//   compares t~'s offset delta = t~ - q from q = T(t~) (exact: t~'s low
+//   bits) and the enclosure's half-width with q's ulps on either side: when
+//   the enclosure lies strictly between q's neighbours, t does, so q is
+//   faithful (and correctly rounded whenever the enclosure also lies within
+//   q's half-ulps, as it does for all but a few of them: see the measured
+//   rates in README.md), and the window [tlo, thi] (T values) is decided by
+//   comparing q with its ends. Where the enclosure is wider than an ulp,
+//   the window is still decided when it lies wholly outside it (or, any-hit,
+//   inside). Otherwise, for double inputs, stage 2b (exact.cpp,
 //   t_double_word) recomputes N and D in double-word arithmetic from exact
 //   differences (relative error ~2^-100 cond) and rounds t correctly; only
 //   what that cannot settle (t within ~2^-95 of a rounding boundary or of a
-//   window end, or inputs beyond 2^250) goes to stage 3. (Float: u = 2^-53 leaves 29 bits for the
-//   rounding decision; double: u = 2^-64 leaves 11: the enclosure, about
-//   2^-60 (1 + 32 cond) |t| wide, cond = 1 / |cos| of the ray's angle to
-//   the normal, straddles a rounding boundary of 1 in 10 of the kernel
-//   bench's double hits, and is wider than half an ulp, so not even
-//   faithful, only where cond > ~2^5.)
+//   window end, or inputs beyond 2^250) goes to stage 3. (Float: u = 2^-53
+//   leaves 29 bits for the rounding decision; double: u = 2^-64 leaves 11:
+//   the enclosure's half-width, about 2^-60 (PN / |N| + PD / |D|) |t|, where
+//   PD / |D| ~ 1 / |cos| of the ray's angle to the normal, passes half an
+//   ulp only where those conditions reach ~2^6.) The first form of this stage rounded both ends of the enclosure
+//   to T and divided for its width: 1.7x watertight's ns on the kernel
+//   bench's double hits against 1.4x now.
 //
 // Exact fallback (stage 3, exact.cpp): GMP rationals (mpq_t, libgmp-dev)
 // over the inputs' exact values: U, V, W as above, det = U + V + W and
@@ -301,8 +306,17 @@ template <class C, class T>
   constexpr double k = double(16 * u) * (1 + 0x1p-48);
   const double eN = k * PN, eD = k * PD;
   const double aN = double(std::abs(N)), aD = double(std::abs(D));
-  if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD))
-    return Dist::undecided;  // t near 0, grazing, untamed (NaN)
+  const T tlo = std::max(r.tmin, T(0)), thi = r.tmax;
+  if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD)) {
+    // t near 0 (N within its error bound), grazing, or untamed (NaN). With
+    // D certain, |t| <= (aN (1 + 2^-52) + eN) / (aD (1 - 2^-53) - eD): a
+    // window starting above that is missed (a shadow ray leaving the
+    // surface, against the triangles it leaves from). The factors 1 -+
+    // 2^-40 cover those and the three roundings here (eD < aD / 4).
+    if (aD > 4 * (1 + 0x1p-40) * eD && (aN + eN) * (1 + 0x1p-40) < (aD - eD) * double(tlo) * (1 - 0x1p-40))
+      return Dist::out;
+    return Dist::undecided;
+  }
   const double K = aN > 0x1p20 * (1 + 0x1p-40) * eN && aD > 0x1p20 * (1 + 0x1p-40) * eD ? 1 + 0x1p-19 : 2;
   const C t = N / D;
   const T q = T(t);
@@ -317,7 +331,6 @@ template <class C, class T>
   const double up = pe * (sizeof(T) == sizeof(float) ? 0x1p-23 : 0x1p-52);
   const double down = aq == pe ? up * 0.5 : up;
   const double Y = K * (eN + eD * aq + 2 * double(u) * aq * aD) * (1 + 0x1p-17);
-  const T tlo = std::max(r.tmin, T(0)), thi = r.tmax;
   if (!(Y < (up - sdelta) * aD * (1 - 0x1p-40) && Y < (down + sdelta) * aD * (1 - 0x1p-40))) {
     // Wider than an ulp: the window is decided only when the whole
     // enclosure [q - w, q + w] lies outside it, or (any-hit: no t to
@@ -376,6 +389,14 @@ template <class T>
     if (ds == Dist::in) return finish<double, T>(t, U, V, W);
     count_exact();
     return hit_exact(r, a, b, c, cull);
+  }
+  // Undecided signs (a ray through or near an edge or vertex): the plane's
+  // t alone may put the crossing outside the window, whatever the signs
+  // (a shadow ray leaving the surface, against the triangles around its
+  // origin; a closest-hit ray behind its best hit).
+  {
+    T t{};
+    if (enclose_t<C>(r, a, pre ? *pre : edges<C>(a, b, c), false, t) == Dist::out) return std::nullopt;
   }
   if constexpr (!kFloat) {
     count_extended();

@@ -15,9 +15,12 @@
 // inside with its sign, undecided) are the scalar filter's; a lane the
 // filter rejects (two certified opposite signs) is the scalar kernel's
 // miss, and every other lane is handed, with its U, V, W and verdict, to
-// after_signs, which is what the scalar test runs next. Nothing else is
-// decided here.
+// after_signs, which is what the scalar test runs next. The one other
+// decision made here is a miss that exact arithmetic makes too (the plane
+// crossed outside the window, by bounds proven beside signs4): the scalar
+// kernel's verdicts are exact, so it answers the same miss.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 
 #include "exact.h"
@@ -51,7 +54,7 @@ struct alignas(4 * sizeof(T)) Tri4 {
 // computes them: sd = |d_x| + |d_y| + |d_z|, ksd = 2^-49 sd, and the range
 // guard's half on sd (sd <= limit, false for NaN).
 struct RayLanes {
-  V4 ox, oy, oz, dx, dy, dz, ksd, limit, tau;
+  V4 ox, oy, oz, dx, dy, dz, ksd, limit, tau, tlo;
   bool sd_ok;
 };
 template <class T>
@@ -61,8 +64,9 @@ template <class T>
   const double sd = std::abs(dx) + std::abs(dy) + std::abs(dz);
   constexpr double k = 16.0 * exact::detail::unit_roundoff<double>();
   constexpr double limit = exact::detail::kFilterLimit<T>, tau = exact::detail::kFilterTau<T>;
-  return {bcast(double(r.o.x)), bcast(double(r.o.y)), bcast(double(r.o.z)), bcast(dx),  bcast(dy), bcast(dz),
-          bcast(k * sd),        bcast(limit),         bcast(tau),           sd <= limit};
+  const double tlo = double(std::max(r.tmin, T(0)));
+  return {bcast(double(r.o.x)), bcast(double(r.o.y)), bcast(double(r.o.z)), bcast(dx),  bcast(dy),  bcast(dz),
+          bcast(k * sd),        bcast(limit),         bcast(tau),           bcast(tlo), sd <= limit};
 }
 
 [[gnu::always_inline]] inline V4 vabs(V4 x) {
@@ -84,13 +88,31 @@ template <class T>
 
 // Stage 1 of 4 lanes: U, V, W per lane and, as bit masks over the lanes,
 // `miss` (rejected: the scalar kernel's miss), `pos` / `neg` (inside with
-// s = +1 / -1). A live lane in neither is undecided.
+// s = +1 / -1). A live lane in neither is undecided. Then, for the live
+// lanes stage 1 did not reject (when there are any), `out`: the plane is
+// certainly crossed outside the window [tlo, thi] (below), so exact
+// arithmetic, and with it the scalar kernel, answers a miss.
+//
+// The window test. N = A' . (B' x C') = n . A' (the header's triple
+// product; its cross product is U's, so it costs three products and two
+// sums) and det = U + V + W = n . d; t = N / det. N~ passes through 8
+// roundings per term (one more than U's: A' is rounded too), so, as for U,
+// |N~ - N| <= gamma(8) 2 |A'|_1 max|B'| max|C'| (1 + 13u) < 2^-48 s_a m_b
+// m_c (+ tau for double inputs, as U's: the factor after the cross product
+// is |a'_i| <= 2^330); det~ = fl(fl(U~ + V~) + W~) is within eU + eV + eW +
+// 2u (1 + u)(|U~| + |V~| + |W~|) of det, taken with 2^-51 and the factor
+// 1 + 2^-40 (its own roundings). With both bounds: t < 0 <= tlo where N and
+// det are certainly of opposite signs; |t| <= (|N~| + eN) / (|det~| -
+// eDet) < tlo; t >= (|N~| - eN) / (|det~| + eDet) > thi where they are
+// certainly of one sign. The products and sums of those comparisons are of
+// nonnegative values (at most 4 roundings a side), covered by the factors
+// 1 -+ 2^-40. Lanes outside the range guard are never `out`.
 struct Signs4 {
   double U[4], V[4], W[4];
-  int miss, pos, neg;
+  int miss, pos, neg, out;
 };
 template <bool kAvx = false, class T>
-[[gnu::always_inline]] inline void signs4(const RayLanes& r, const Tri4<T>& tri, Signs4& out) {
+[[gnu::always_inline]] inline void signs4(const RayLanes& r, double thi, const Tri4<T>& tri, int live, Signs4& out) {
   const V4 dx = r.dx, dy = r.dy, dz = r.dz;
   const V4 ax = load(tri.v[0]) - r.ox, ay = load(tri.v[1]) - r.oy, az = load(tri.v[2]) - r.oz;
   const V4 bx = load(tri.v[3]) - r.ox, by = load(tri.v[4]) - r.oy, bz = load(tri.v[5]) - r.oz;
@@ -115,17 +137,32 @@ template <bool kAvx = false, class T>
   __builtin_memcpy(out.U, &U, sizeof U);
   __builtin_memcpy(out.V, &V, sizeof V);
   __builtin_memcpy(out.W, &W, sizeof W);
+  out.out = 0;
+  if (const int cand = live & ~out.miss & ok) {
+    using moller_simd::bcast;
+    const V4 N = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx);
+    const V4 eN = bcast(0x1p-48) * (vabs(ax) + vabs(ay) + vabs(az)) * mb * mc + r.tau;
+    const V4 det = U + V + W;
+    const V4 eDet = (eU + eV + eW + bcast(0x1p-51) * (vabs(U) + vabs(V) + vabs(W))) * bcast(1 + 0x1p-40);
+    const V4 aN = vabs(N), aDet = vabs(det), up = bcast(1 + 0x1p-40), down = bcast(1 - 0x1p-40);
+    const M4 np = N > eN, nn = N<-eN, dp = det> eDet, dn = det < -eDet;
+    const M4 behind = (np & dn) | (nn & dp);
+    const M4 near = (dp | dn) & ((aN + eN) * up < (aDet - eDet) * r.tlo * down);
+    const M4 beyond = ((np & dp) | (nn & dn)) & ((aN - eN) * down > (aDet + eDet) * bcast(thi) * up);
+    out.out = moller_simd::mask_bits<kAvx>(guard & (behind | near | beyond)) & cand;
+  }
 }
 
 // The leaf: f(lane, exact::detail::Signs, U, V, W, s) for each of the
-// `live` lanes (bit i: lane i) that stage 1 did not reject; the caller
-// finishes each with after_signs on the lane's triangle.
+// `live` lanes (bit i: lane i) that neither stage 1 nor the window test
+// rejected; the caller finishes each with after_signs on the lane's
+// triangle. thi: the window's current end.
 template <bool kAvx = false, class T, class F>
-[[gnu::always_inline]] inline void leaf4(const RayLanes& r, const Tri4<T>& tri, int live, F&& f) {
+[[gnu::always_inline]] inline void leaf4(const RayLanes& r, T thi, const Tri4<T>& tri, int live, F&& f) {
   Signs4 s;
-  signs4<kAvx>(r, tri, s);
+  signs4<kAvx>(r, double(thi), tri, live, s);
   using exact::detail::Signs;
-  for (int rest = live & ~s.miss; rest; rest &= rest - 1) {
+  for (int rest = live & ~s.miss & ~s.out; rest; rest &= rest - 1) {
     const int l = __builtin_ctz(unsigned(rest));
     const int bit = 1 << l;
     const Signs sg = (s.pos | s.neg) & bit ? Signs::inside : Signs::undecided;

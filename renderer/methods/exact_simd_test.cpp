@@ -1,5 +1,6 @@
 // methods/exact_simd.h against methods/exact.h: every lane's stage 1 must be
-// the scalar filter's (U, V, W bit for bit, the same verdict), and the leaf's
+// the scalar filter's (U, V, W bit for bit, the same verdict), a lane the
+// window test rejects must be the scalar kernel's miss, and the leaf's
 // answer, a rejected lane's miss or after_signs on the lane's values, must
 // be the scalar kernel's (hit or miss, t, b1, b2 bit for bit), for closest
 // and any-hit, culled or not, on seeded random and adversarial inputs:
@@ -32,19 +33,20 @@ bool same_bits(T a, T b) {
 // Stage 1 of the block in the form the tracer's AVX2 entry points compile
 // (kAvx: vmovmskpd), and in baseline SSE.
 template <class T>
-[[gnu::target("avx2,fma"), gnu::noinline]] void signs4_avx2(const exact_simd::RayLanes& r,
-                                                            const exact_simd::Tri4<T>& tri, exact_simd::Signs4& out) {
-  exact_simd::signs4<true>(r, tri, out);
+[[gnu::target("avx2,fma"), gnu::noinline]] void signs4_avx2(const exact_simd::RayLanes& r, double thi,
+                                                            const exact_simd::Tri4<T>& tri, int live,
+                                                            exact_simd::Signs4& out) {
+  exact_simd::signs4<true>(r, thi, tri, live, out);
 }
 template <class T>
-[[gnu::noinline]] void signs4_base(const exact_simd::RayLanes& r, const exact_simd::Tri4<T>& tri,
+[[gnu::noinline]] void signs4_base(const exact_simd::RayLanes& r, double thi, const exact_simd::Tri4<T>& tri, int live,
                                    exact_simd::Signs4& out) {
-  exact_simd::signs4<false>(r, tri, out);
+  exact_simd::signs4<false>(r, thi, tri, live, out);
 }
 
 // How often each path was seen, so that the test can insist every one was.
 struct Seen {
-  long miss = 0, inside = 0, undecided = 0, hits = 0, lanes = 0;
+  long miss = 0, inside = 0, undecided = 0, out = 0, hits = 0, lanes = 0;
 };
 
 // Compares the 4 lanes of one block (live lanes: the first `count`) with
@@ -55,10 +57,13 @@ void compare_block(const Ray<T>& r, const Vec3<T> (&v)[4][3], int count, bool av
   for (int l = 0; l < 4; ++l) blk.set(l, v[l][0], v[l][1], v[l][2]);
   const exact_simd::RayLanes lanes = exact_simd::ray_lanes(r);
   exact_simd::Signs4 s;
+  const int live = (1 << count) - 1;
   if (avx)
-    signs4_avx2(lanes, blk, s);
+    signs4_avx2(lanes, double(r.tmax), blk, live, s);
   else
-    signs4_base(lanes, blk, s);
+    signs4_base(lanes, double(r.tmax), blk, live, s);
+  EXPECT_EQ(s.out & ~live, 0);
+  EXPECT_EQ(s.out & s.miss, 0);
   for (int l = 0; l < count; ++l) {
     const int bit = 1 << l;
     const Vec3<T>&a = v[l][0], &b = v[l][1], &c = v[l][2];
@@ -69,7 +74,7 @@ void compare_block(const Ray<T>& r, const Vec3<T> (&v)[4][3], int count, bool av
     // Stage 1: the same values and verdict.
     EXPECT_TRUE(same_bits(U, s.U[l]) && same_bits(V, s.V[l]) && same_bits(W, s.W[l]))
         << "lane " << l << ": U " << U << " " << s.U[l] << ", V " << V << " " << s.V[l] << ", W " << W << " " << s.W[l];
-    const bool miss = s.miss & bit, pos = s.pos & bit, neg = s.neg & bit;
+    const bool miss = s.miss & bit, pos = s.pos & bit, neg = s.neg & bit, out = s.out & bit;
     EXPECT_EQ(miss, sg == Signs::miss) << "lane " << l;
     EXPECT_EQ(pos || neg, sg == Signs::inside) << "lane " << l;
     if (sg == Signs::inside) {
@@ -79,6 +84,7 @@ void compare_block(const Ray<T>& r, const Vec3<T> (&v)[4][3], int count, bool av
     seen.miss += sg == Signs::miss;
     seen.inside += sg == Signs::inside;
     seen.undecided += sg == Signs::undecided;
+    seen.out += out;
     // The whole answer, as the tracer's leaf forms it, against the scalar
     // prepared kernel.
     const auto p = exact::detail::prepare(a, b, c);
@@ -86,9 +92,9 @@ void compare_block(const Ray<T>& r, const Vec3<T> (&v)[4][3], int count, bool av
     const int lane_s = pos ? 1 : neg ? -1 : 0;
     for (bool cull : {false, true}) {
       const auto want = exact::hit(r, p, cull);
-      const auto got = miss ? std::nullopt
-                            : exact::detail::after_signs(lane_sg, s.U[l], s.V[l], s.W[l], lane_s, r, p.a, p.b, p.c,
-                                                         &p.e, cull, true);
+      const auto got = miss || out ? std::nullopt
+                                   : exact::detail::after_signs(lane_sg, s.U[l], s.V[l], s.W[l], lane_s, r, p.a, p.b,
+                                                                p.c, &p.e, cull, true);
       ASSERT_EQ(want.has_value(), got.has_value()) << "lane " << l << " cull " << cull;
       if (want) {
         EXPECT_TRUE(same_bits(want->t, got->t)) << want->t << " vs " << got->t;
@@ -96,22 +102,23 @@ void compare_block(const Ray<T>& r, const Vec3<T> (&v)[4][3], int count, bool av
         EXPECT_TRUE(same_bits(want->b2, got->b2)) << want->b2 << " vs " << got->b2;
         ++seen.hits;
       }
-      const bool any_got = !miss && exact::detail::after_signs(lane_sg, s.U[l], s.V[l], s.W[l], lane_s, r, p.a, p.b,
-                                                               p.c, &p.e, cull, false)
-                                        .has_value();
+      const bool any_got =
+          !miss && !out &&
+          exact::detail::after_signs(lane_sg, s.U[l], s.V[l], s.W[l], lane_s, r, p.a, p.b, p.c, &p.e, cull, false)
+              .has_value();
       EXPECT_EQ(exact::any(r, p, cull), any_got) << "lane " << l << " cull " << cull;
     }
   }
   // leaf4 visits exactly the live lanes stage 1 did not reject, with their values.
   int visited = 0;
-  exact_simd::leaf4(lanes, blk, (1 << count) - 1, [&](int l, Signs sg, double U, double V, double W, int sign) {
+  exact_simd::leaf4(lanes, r.tmax, blk, live, [&](int l, Signs sg, double U, double V, double W, int sign) {
     visited |= 1 << l;
     EXPECT_TRUE(same_bits(U, s.U[l]) && same_bits(V, s.V[l]) && same_bits(W, s.W[l]));
     EXPECT_EQ(sg == Signs::inside, bool((s.pos | s.neg) >> l & 1));
     EXPECT_EQ(sign, (s.pos >> l & 1) ? 1 : (s.neg >> l & 1) ? -1 : 0);
     return false;
   });
-  EXPECT_EQ(visited, ((1 << count) - 1) & ~s.miss);
+  EXPECT_EQ(visited, live & ~s.miss & ~s.out);
 }
 
 template <class T>
@@ -161,13 +168,23 @@ void random_and_adversarial(std::uint64_t seed, bool avx) {
     }
     if (family == 9 && iter % 30 == 9) r.d.x = std::numeric_limits<T>::quiet_NaN();
     if (family == 9 && iter % 30 == 19) r.o.y = std::numeric_limits<T>::infinity();
+    if (iter % 7 == 3 && family < 8) {
+      // A shadow ray: from the surface of triangle 0 (its aimed-at point),
+      // away from it, clear of it by tmin.
+      r.o = target;
+      r.d = Vec3<T>(T(u(rng)), T(u(rng)), T(u(rng)));
+      r.tmin = T(1e-4);
+    }
+    if (iter % 11 == 5) r.tmax = T(0.5 + w(rng));  // a window closing among the triangles
     if (iter % 3 == 0) {
       // A window ending exactly at the scalar kernel's t, or starting there.
       if (auto h = exact::hit(r, v[0][0], v[0][1], v[0][2], false)) (iter % 2 ? r.tmax : r.tmin) = h->t;
     }
     compare_block(r, v, 1 + iter % 4, avx, seen);
   }
-  // Every path was taken: rejected, certified inside, undecided; and hits.
+  // Every path was taken: rejected, certified inside, undecided, outside
+  // the window; and hits.
+  EXPECT_GT(seen.out, seen.lanes / 50);
   EXPECT_GT(seen.miss, seen.lanes / 10);
   EXPECT_GT(seen.inside, seen.lanes / 20);
   EXPECT_GT(seen.undecided, seen.lanes / 50);
