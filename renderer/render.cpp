@@ -200,6 +200,18 @@ struct Tracer::Impl {
         meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
       else
         meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
+      // exact's leaves read their blocks alone (exact_lane): its records
+      // (144 bytes a triangle in double) are not kept. The lone triangles'
+      // soup keeps them: its traversals test records.
+      auto drop_records = [&](auto& m) {
+        if (m.xtri4.empty()) return;
+        m.pre = {};
+        set_neighbour_prefetch(m, m.xtri4.size() * sizeof(m.xtri4[0]));
+      };
+      if (opt.use_double)
+        drop_records(meshes_d.back());
+      else
+        drop_records(meshes_f.back());
     }
     // The sphere far rays are moved to (shift): around every mesh, with the
     // least padding and the largest scale among them.
@@ -563,8 +575,7 @@ struct Tracer::Impl {
 
   // exact's prepared record of BVH slot s.
   template <class T>
-  [[gnu::always_inline]] static inline const exact::detail::Prepared<T>& exact_pre(const PreparedMesh<T>& m,
-                                                                                   std::size_t s) {
+  static const exact::detail::Prepared<T>& exact_pre(const PreparedMesh<T>& m, std::size_t s) {
     return *reinterpret_cast<const exact::detail::Prepared<T>*>(m.pre.data() + s * m.stride);
   }
 
@@ -642,13 +653,19 @@ struct Tracer::Impl {
   }
 
   // A lane of exact's leaf that its stage 1 did not reject, finished by the
-  // scalar code from the lane's U, V, W (not inlined: most leaves reach it
-  // for no lane, and the x87 and exact stages would crowd the traversal).
+  // scalar code from the lane's U, V, W, with the triangle's stage 1b terms
+  // made from the block's vertices (edges(), the very values the prepared
+  // record holds): the block's lines are in cache, a record beside it was
+  // not (on the dragon, a miss to memory for each lane left, 0.54x Embree
+  // on primary rays). Not inlined: most leaves reach it for no lane, and
+  // the x87 and exact stages would crowd the traversal.
   template <class T, bool kNeedT>
   [[gnu::noinline]] static std::optional<TriangleHit<T>> exact_lane(exact::detail::Signs sg, double U, double V,
                                                                     double W, int s, const Ray<T>& r,
-                                                                    const exact::detail::Prepared<T>& p, bool cull) {
-    return exact::detail::after_signs(sg, U, V, W, s, r, p.a, p.b, p.c, &p.e, cull, kNeedT);
+                                                                    const exact_simd::Tri4<T>& blk, int l, bool cull) {
+    const Vec3<T> a{blk.v[0][l], blk.v[1][l], blk.v[2][l]}, b{blk.v[3][l], blk.v[4][l], blk.v[5][l]},
+        c{blk.v[6][l], blk.v[7][l], blk.v[8][l]};
+    return exact::detail::after_signs(sg, U, V, W, s, r, a, b, c, nullptr, cull, kNeedT);
   }
 
   // The closest hit in a mesh of 4-wide leaves (Möller's tri4 or exact's xtri4) through its
@@ -667,7 +684,7 @@ struct Tracer::Impl {
                 [&](int l, exact::detail::Signs sg, double U, double V, double W, int s)
                     __attribute__((always_inline)) {
                       const std::size_t slot = first + std::uint32_t(l);
-                      if (auto h = exact_lane<T, true>(sg, U, V, W, s, window, exact_pre(m, slot), cull))
+                      if (auto h = exact_lane<T, true>(sg, U, V, W, s, window, m.xtri4[first / 4], l, cull))
                         consider(double(h->t), oi, int(m.bvh.order[slot]), double(h->b1), double(h->b2));
                       return false;
                     });
@@ -700,12 +717,11 @@ struct Tracer::Impl {
           [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
             exact_simd::leaf4<kFma>(
                 lanes, r.tmax, m.xtri4[first / 4], (1 << count) - 1,
-                [&](int l, exact::detail::Signs sg, double U, double V, double W,
-                    int s) __attribute__((always_inline)) {
-                  // never culled: see closest()
-                  return hit = exact_lane<T, false>(sg, U, V, W, s, r, exact_pre(m, first + std::uint32_t(l)), false)
-                                   .has_value();
-                });
+                [&](int l, exact::detail::Signs sg, double U, double V, double W, int s)
+                    __attribute__((always_inline)) {
+                      // never culled: see closest()
+                      return hit = exact_lane<T, false>(sg, U, V, W, s, r, m.xtri4[first / 4], l, false).has_value();
+                    });
             return hit;
           },
           [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.xtri4[first / 4]); });
