@@ -134,8 +134,10 @@
 // Measured (2-core shared machine; renderer/methods/README.md has the
 // table): `rayaudit audit --methods exact --rays 1000000` 0 in every error
 // column, float and double (t at most 1 ulp from the oracle's); kernel
-// bench (hit=50, back=50, nocull) 1.18x watertight's ns per test in float,
-// 1.86x in double (the x87 stage); crack maps 0 leaks, 0 false pixels.
+// bench (hit=50, back=50, nocull) 1.26x watertight's ns per test in float,
+// 1.61x in double (the x87 stage; 1.89x before the division-free
+// certificate); crack maps 0 leaks, 0 false pixels. The BVH's leaves run
+// stage 1 four triangles at a time (exact_simd.h), answering as this code.
 #pragma once
 #include <algorithm>
 #include <bit>
