@@ -668,6 +668,29 @@ struct Tracer::Impl {
     return exact::detail::after_signs(sg, U, V, W, s, r, a, b, c, nullptr, cull, kNeedT);
   }
 
+  // exact's 4-lane leaves through the mesh's BVH (kClosest: nearest first,
+  // the window narrowed by the caller through `r`): on_hit(slot, hit) for
+  // every lane's hit until it returns true.
+  template <bool kClosest, bool kFma, class T, class OnHit>
+  [[gnu::always_inline]] static inline void walk_exact(const PreparedMesh<T>& m, bool boxed, const Ray<T>& r, bool cull,
+                                                       OnHit&& on_hit) {
+    const exact_simd::RayLanes lanes = exact_simd::ray_lanes(r);
+    walk_mesh<kClosest, kFma>(
+        m, boxed, r.o, r.d, r.tmin, r.tmax,
+        [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+          bool stop = false;
+          exact_simd::leaf4<kFma>(
+              lanes, r.tmax, m.xtri4[first / 4], (1 << count) - 1,
+              [&](int l, exact::detail::Signs sg, double U, double V, double W, int s) __attribute__((always_inline)) {
+                if (auto h = exact_lane<T, kClosest>(sg, U, V, W, s, r, m.xtri4[first / 4], l, cull))
+                  stop = on_hit(first + std::uint32_t(l), *h);
+                return stop;
+              });
+          return stop;
+        },
+        [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.xtri4[first / 4]); });
+  }
+
   // The closest hit in a mesh of 4-wide leaves (Möller's tri4 or exact's xtri4) through its
   // BVH: consider(t, object, prim, b1, b2) for every hit in the window,
   // which it narrows.
@@ -675,22 +698,11 @@ struct Tracer::Impl {
   [[gnu::always_inline]] static inline void closest_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& window,
                                                             int oi, bool cull, Consider&& consider) {
     if (!m.xtri4.empty()) {
-      const exact_simd::RayLanes lanes = exact_simd::ray_lanes(window);
-      walk_mesh<true, kFma>(
-          m, boxed, window.o, window.d, window.tmin, window.tmax,
-          [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-            exact_simd::leaf4<kFma>(
-                lanes, window.tmax, m.xtri4[first / 4], (1 << count) - 1,
-                [&](int l, exact::detail::Signs sg, double U, double V, double W, int s)
-                    __attribute__((always_inline)) {
-                      const std::size_t slot = first + std::uint32_t(l);
-                      if (auto h = exact_lane<T, true>(sg, U, V, W, s, window, m.xtri4[first / 4], l, cull))
-                        consider(double(h->t), oi, int(m.bvh.order[slot]), double(h->b1), double(h->b2));
-                      return false;
-                    });
+      walk_exact<true, kFma>(
+          m, boxed, window, cull, [&](std::uint32_t slot, const TriangleHit<T>& h) __attribute__((always_inline)) {
+            consider(double(h.t), oi, int(m.bvh.order[slot]), double(h.b1), double(h.b2));
             return false;
-          },
-          [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.xtri4[first / 4]); });
+          });
       return;
     }
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(window);
@@ -711,20 +723,10 @@ struct Tracer::Impl {
   [[gnu::always_inline]] static inline bool any_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& r) {
     bool hit = false;
     if (!m.xtri4.empty()) {
-      const exact_simd::RayLanes lanes = exact_simd::ray_lanes(r);
-      walk_mesh<false, kFma>(
-          m, boxed, r.o, r.d, r.tmin, r.tmax,
-          [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
-            exact_simd::leaf4<kFma>(
-                lanes, r.tmax, m.xtri4[first / 4], (1 << count) - 1,
-                [&](int l, exact::detail::Signs sg, double U, double V, double W, int s)
-                    __attribute__((always_inline)) {
-                      // never culled: see closest()
-                      return hit = exact_lane<T, false>(sg, U, V, W, s, r, m.xtri4[first / 4], l, false).has_value();
-                    });
-            return hit;
-          },
-          [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.xtri4[first / 4]); });
+      // never culled: see closest()
+      walk_exact<false, kFma>(
+          m, boxed, r,
+          false, [&](std::uint32_t, const TriangleHit<T>&) __attribute__((always_inline)) { return hit = true; });
       return hit;
     }
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(r);

@@ -19,6 +19,7 @@
 #include <random>
 
 #include "methods/exact.h"
+#include "methods/simd_test_blocks.h"
 
 namespace ra {
 namespace {
@@ -195,23 +196,8 @@ void random_and_adversarial(std::uint64_t seed, bool avx) {
 // coordinate planes, through vertices and edges.
 template <class T>
 void signed_zero_rays(bool avx) {
-  const T z = T(0), nz = -T(0);
-  const T comps[] = {nz, z, T(0.25), T(-0.25), T(1), T(-1)};
   Seen seen;
-  for (T ox : comps)
-    for (T oy : comps)
-      for (T dx : {nz, z, T(0.5)})
-        for (T dy : {nz, z, T(-0.5)}) {
-          Ray<T> r;
-          r.o = Vec3<T>(ox, oy, T(1));
-          r.d = Vec3<T>(dx, dy, T(-1));
-          r.tmin = nz;
-          const Vec3<T> v[4][3] = {{Vec3<T>(z, z, z), Vec3<T>(T(1), z, z), Vec3<T>(z, T(1), z)},
-                                   {Vec3<T>(nz, nz, nz), Vec3<T>(z, T(1), z), Vec3<T>(T(1), z, z)},
-                                   {Vec3<T>(T(-1), z, z), Vec3<T>(z, z, z), Vec3<T>(z, T(-1), z)},
-                                   {Vec3<T>(z, z, T(1)), Vec3<T>(T(1), z, T(1)), Vec3<T>(z, T(1), T(1))}};
-          compare_block(r, v, 4, avx, seen);
-        }
+  for_each_signed_zero_block<T>([&](const Ray<T>& r, const Vec3<T>(&v)[4][3]) { compare_block(r, v, 4, avx, seen); });
   EXPECT_GT(seen.hits, 0);
 }
 
