@@ -22,6 +22,7 @@
 #include "errors.h"
 #include "huge_pages.h"
 #include "memory_budget.h"
+#include "methods/exact_simd.h"
 #include "methods/moller_simd.h"
 #include "pov_mesh.h"
 #include "registry.h"
@@ -80,7 +81,9 @@ struct DefaultInit : std::allocator<T> {
 // unit_normal). With --accel bvh the prepared bytes are stored in the
 // BVH's slot order (bvh.order maps a slot to its triangle), except for
 // moller, whose leaves are 4-lane blocks instead (methods/moller_simd.h;
-// `pre` stays empty).
+// `pre` stays empty). exact's leaves are 4-lane blocks of vertices too
+// (methods/exact_simd.h: its stage 1), beside `pre` in slot order, which
+// the lanes that stage 1 does not reject finish from.
 template <class T>
 struct PreparedMesh {
   const TriangleSet* set = nullptr;
@@ -88,6 +91,7 @@ struct PreparedMesh {
   std::vector<unsigned char> pre;                                             // per triangle, or per BVH slot
   Bvh bvh;                                                                    // --accel bvh only
   std::vector<moller_simd::Tri4<T>, DefaultInit<moller_simd::Tri4<T>>> tri4;  // per BVH leaf, moller only
+  std::vector<exact_simd::Tri4<T>, DefaultInit<exact_simd::Tri4<T>>> xtri4;   // per BVH leaf, exact only
   std::vector<Vec3d> vertex_normal;  // smooth shading without vn: area-weighted
   Vec3d bs_center;
   double bs_radius = 0;
@@ -96,6 +100,7 @@ struct PreparedMesh {
   double scale = 0;                      // max(its size, its farthest coordinate): pad = 1e-5 scale
   std::uint32_t one_leaf = Bvh::kEmpty;  // the BVH's only leaf, when it has one (at most 4 triangles)
   bool cull = false;                     // --cull, and the mesh is closed (cull_unsafe_reason)
+  bool lanes4() const { return !tri4.empty() || !xtri4.empty(); }  // 4-lane leaves (moller's or exact's)
 };
 
 // Asks for a leaf block's cache lines ahead of its test.
@@ -195,6 +200,18 @@ struct Tracer::Impl {
         meshes_d.push_back(prepare<double>(*s.objects[i].mesh));
       else
         meshes_f.push_back(prepare<float>(*s.objects[i].mesh));
+      // exact's leaves read their blocks alone (exact_lane): its records
+      // (144 bytes a triangle in double) are not kept. The lone triangles'
+      // soup keeps them: its traversals test records.
+      auto drop_records = [&](auto& m) {
+        if (m.xtri4.empty()) return;
+        m.pre = {};
+        set_neighbour_prefetch(m, m.xtri4.size() * sizeof(m.xtri4[0]));
+      };
+      if (opt.use_double)
+        drop_records(meshes_d.back());
+      else
+        drop_records(meshes_f.back());
     }
     // The sphere far rays are moved to (shift): around every mesh, with the
     // least padding and the largest scale among them.
@@ -224,7 +241,7 @@ struct Tracer::Impl {
     build_object_bvh();
     init_glass();
     one_mesh_tri4 = avx2 && s.objects.size() == 1 && s.objects[0].kind == Object::Kind::mesh &&
-                    !opt.pov_mesh_intersect && (opt.use_double ? !meshes_d[0].tri4.empty() : !meshes_f[0].tri4.empty());
+                    !opt.pov_mesh_intersect && (opt.use_double ? meshes_d[0].lanes4() : meshes_f[0].lanes4());
     for (const Object& obj : s.objects) {
       if (obj.kind == Object::Kind::mesh)
         for (const Material& m : obj.mesh->materials) load_textures(m);
@@ -394,6 +411,9 @@ struct Tracer::Impl {
   // BVH its leaves are tested from tri4 alone, and the per-triangle bytes
   // are not made.
   bool bvh_tri4() const { return opt.accel == Accel::bvh && tri_method->name == "moller"; }
+  // exact's 4-lane stage 1 answers as its scalar form (the lanes it does
+  // not reject are finished by the scalar code from `pre`).
+  bool bvh_exact4() const { return opt.accel == Accel::bvh && tri_method->name == "exact"; }
 
   // f(begin, end) over [0, n) in chunks on the tracer's threads; on this
   // one below 2 chunks (starting threads would cost more). The results
@@ -535,7 +555,28 @@ struct Tracer::Impl {
       }
     });
     m.pre = std::move(pre);
-    set_neighbour_prefetch(m, m.pre.size());
+    if (bvh_exact4()) {
+      m.xtri4.resize(slots / 4);
+      parallel_chunks(slots / 4, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t l = begin; l < end; ++l)
+          for (std::size_t j = 0; j < 4; ++j) {
+            const std::size_t s = 4 * l + j;
+            if (m.bvh.order[s] == Bvh::kNoTriangle) {  // never looked at: the leaf's count excludes it
+              m.xtri4[l].set(int(j), Vec3<T>{0, 0, 0}, Vec3<T>{0, 0, 0}, Vec3<T>{0, 0, 0});
+              continue;
+            }
+            const auto& p = exact_pre(m, s);
+            m.xtri4[l].set(int(j), p.a, p.b, p.c);
+          }
+      });
+    }
+    set_neighbour_prefetch(m, m.pre.size() + m.xtri4.size() * sizeof(m.xtri4[0]));
+  }
+
+  // exact's prepared record of BVH slot s.
+  template <class T>
+  static const exact::detail::Prepared<T>& exact_pre(const PreparedMesh<T>& m, std::size_t s) {
+    return *reinterpret_cast<const exact::detail::Prepared<T>*>(m.pre.data() + s * m.stride);
   }
 
   // Above this many bytes of nodes and leaves, a mesh's BVH traversal asks
@@ -611,12 +652,59 @@ struct Tracer::Impl {
       return meshes_d;
   }
 
-  // The closest hit in a mesh of Möller 4-wide leaves (tri4) through its
+  // A lane of exact's leaf that its stage 1 did not reject, finished by the
+  // scalar code from the lane's U, V, W, with the triangle's stage 1b terms
+  // made from the block's vertices (edges(), the very values the prepared
+  // record holds): the block's lines are in cache, a record beside it was
+  // not (on the dragon, a miss to memory for each lane left, 0.54x Embree
+  // on primary rays). Not inlined: most leaves reach it for no lane, and
+  // the x87 and exact stages would crowd the traversal.
+  template <class T, bool kNeedT>
+  [[gnu::noinline]] static std::optional<TriangleHit<T>> exact_lane(exact::detail::Signs sg, double U, double V,
+                                                                    double W, int s, const Ray<T>& r,
+                                                                    const exact_simd::Tri4<T>& blk, int l, bool cull) {
+    const Vec3<T> a{blk.v[0][l], blk.v[1][l], blk.v[2][l]}, b{blk.v[3][l], blk.v[4][l], blk.v[5][l]},
+        c{blk.v[6][l], blk.v[7][l], blk.v[8][l]};
+    return exact::detail::after_signs(sg, U, V, W, s, r, a, b, c, nullptr, cull, kNeedT);
+  }
+
+  // exact's 4-lane leaves through the mesh's BVH (kClosest: nearest first,
+  // the window narrowed by the caller through `r`): on_hit(slot, hit) for
+  // every lane's hit until it returns true.
+  template <bool kClosest, bool kFma, class T, class OnHit>
+  [[gnu::always_inline]] static inline void walk_exact(const PreparedMesh<T>& m, bool boxed, const Ray<T>& r, bool cull,
+                                                       OnHit&& on_hit) {
+    const exact_simd::RayLanes lanes = exact_simd::ray_lanes(r);
+    walk_mesh<kClosest, kFma>(
+        m, boxed, r.o, r.d, r.tmin, r.tmax,
+        [&](std::uint32_t first, std::uint32_t count) __attribute__((always_inline)) {
+          bool stop = false;
+          exact_simd::leaf4<kFma>(
+              lanes, r.tmax, m.xtri4[first / 4], (1 << count) - 1,
+              [&](int l, exact::detail::Signs sg, double U, double V, double W, int s) __attribute__((always_inline)) {
+                if (auto h = exact_lane<T, kClosest>(sg, U, V, W, s, r, m.xtri4[first / 4], l, cull))
+                  stop = on_hit(first + std::uint32_t(l), *h);
+                return stop;
+              });
+          return stop;
+        },
+        [&](std::uint32_t first) __attribute__((always_inline)) { prefetch_block(m.xtri4[first / 4]); });
+  }
+
+  // The closest hit in a mesh of 4-wide leaves (Möller's tri4 or exact's xtri4) through its
   // BVH: consider(t, object, prim, b1, b2) for every hit in the window,
   // which it narrows.
   template <bool kFma, class T, class Consider>
   [[gnu::always_inline]] static inline void closest_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& window,
                                                             int oi, bool cull, Consider&& consider) {
+    if (!m.xtri4.empty()) {
+      walk_exact<true, kFma>(
+          m, boxed, window, cull, [&](std::uint32_t slot, const TriangleHit<T>& h) __attribute__((always_inline)) {
+            consider(double(h.t), oi, int(m.bvh.order[slot]), double(h.b1), double(h.b2));
+            return false;
+          });
+      return;
+    }
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(window);
     walk_mesh<true, kFma>(
         m, boxed, window.o, window.d, window.tmin, window.tmax,
@@ -634,6 +722,13 @@ struct Tracer::Impl {
   template <bool kFma, class T>
   [[gnu::always_inline]] static inline bool any_in_tri4(const PreparedMesh<T>& m, bool boxed, const Ray<T>& r) {
     bool hit = false;
+    if (!m.xtri4.empty()) {
+      // never culled: see closest()
+      walk_exact<false, kFma>(
+          m, boxed, r,
+          false, [&](std::uint32_t, const TriangleHit<T>&) __attribute__((always_inline)) { return hit = true; });
+      return hit;
+    }
     const moller_simd::RayLanes<T> lanes = moller_simd::ray_lanes(r);
     walk_mesh<false, kFma>(
         m, boxed, r.o, r.d, r.tmin, r.tmax,
@@ -748,7 +843,7 @@ struct Tracer::Impl {
             lr.tmax = std::min(lr.tmax, T(t));
           };
           if (opt.accel == Accel::bvh) {
-            if (!m.tri4.empty()) {
+            if (m.lanes4()) {
               closest_in_tri4<kFma>(m, boxed, lr, int(oi), cull && m.cull, local);
               break;
             }
@@ -910,7 +1005,7 @@ struct Tracer::Impl {
           const Ray<T> lr = moved_any(r);  // as closest_impl's
           if (opt.accel == Accel::bvh) {
             bool hit = false;
-            if (!m.tri4.empty()) {
+            if (m.lanes4()) {
               hit = any_in_tri4<kFma>(m, boxed, lr);
             } else {
               walk_mesh<false, kFma>(

@@ -45,7 +45,8 @@
 //    exact t (at most 1 ulp from it), and correctly rounded (to nearest)
 //    whenever the filter's whole enclosure of t rounds to one value (float
 //    rays, computed in double: all but about 1 in 2^20; double rays, in long
-//    double: about 9 in 10) and always on the exact path (MPFR). The
+//    double: about 9 in 10), on the double-word stage and on the exact path
+//    (MPFR). The
 //    value is a deterministic function of the inputs (the same operations
 //    in the same order), so the direct and the prepared forms return the
 //    same bits (exact_test.cpp checks it).
@@ -94,24 +95,28 @@
 //   Pn_i = |e1_j e2_k| + |e1_k e2_j|; with the same accounting of computed
 //   magnitudes as above, errN = 16 u PN~, errD = 16 u PD~.
 //   With a = errN / |N~| <= 1/4 and b = errD / |D~| <= 1/4, t~ = fl(N~ / D~):
-//     |t / t~ - 1| <= (a + b + u) / ((1 - b)(1 - u)) <= 2 (a + b) + 3u,
-//   so t lies in [lo, hi] = t~ -+ |t~| (2 (a + b) + 16u): computing the
-//   width costs at most 4 roundings of a value <= 1.01 |t~| and lo, hi one
-//   each of a value <= 2|t~|, 4u + 2u + ... < 13u, covered by 16u - 3u.
-//   The window is decided when [lo, hi] lies inside it or outside it. Rounding to nearest is
-//   monotone, so when T(lo) == T(hi) every value in [lo, hi], t among them,
-//   rounds to that one T: t correctly rounded. Otherwise, when [lo, hi]
-//   lies strictly between the neighbours of q = T(t~), t does too: q is
-//   faithful. Otherwise, for double inputs, stage 2b (exact.cpp,
+//     |t / t~ - 1| <= (a + b + u + bu) / ((1 - b)(1 - u)) <= K (a + b + 2u),
+//   K = 2, or 1 + 2^-19 when a, b <= 2^-20 (almost always). The certificate
+//   (beside enclose_t) multiplies through by |D~| instead of dividing, and
+//   compares t~'s offset delta = t~ - q from q = T(t~) (exact: t~'s low
+//   bits) and the enclosure's half-width with q's ulps on either side: when
+//   the enclosure lies strictly between q's neighbours, t does, so q is
+//   faithful (and correctly rounded whenever the enclosure also lies within
+//   q's half-ulps, as it does for all but a few of them: see the measured
+//   rates in README.md), and the window [tlo, thi] (T values) is decided by
+//   comparing q with its ends. Where the enclosure is wider than an ulp,
+//   the window is still decided when it lies wholly outside it (or, any-hit,
+//   inside). Otherwise, for double inputs, stage 2b (exact.cpp,
 //   t_double_word) recomputes N and D in double-word arithmetic from exact
 //   differences (relative error ~2^-100 cond) and rounds t correctly; only
 //   what that cannot settle (t within ~2^-95 of a rounding boundary or of a
-//   window end, or inputs beyond 2^250) goes to stage 3. (Float: u = 2^-53 leaves 29 bits for the
-//   rounding decision; double: u = 2^-64 leaves 11: the enclosure, about
-//   2^-60 (1 + 32 cond) |t| wide, cond = 1 / |cos| of the ray's angle to
-//   the normal, straddles a rounding boundary of 1 in 10 of the kernel
-//   bench's double hits, and is wider than half an ulp, so not even
-//   faithful, only where cond > ~2^5.)
+//   window end, or inputs beyond 2^250) goes to stage 3. (Float: u = 2^-53
+//   leaves 29 bits for the rounding decision; double: u = 2^-64 leaves 11:
+//   the enclosure's half-width, about 2^-60 (PN / |N| + PD / |D|) |t|, where
+//   PD / |D| ~ 1 / |cos| of the ray's angle to the normal, passes half an
+//   ulp only where those conditions reach ~2^6.) The first form of this stage rounded both ends of the enclosure
+//   to T and divided for its width: 1.7x watertight's ns on the kernel
+//   bench's double hits against 1.4x now.
 //
 // Exact fallback (stage 3, exact.cpp): GMP rationals (mpq_t, libgmp-dev)
 // over the inputs' exact values: U, V, W as above, det = U + V + W and
@@ -129,10 +134,13 @@
 // Measured (2-core shared machine; renderer/methods/README.md has the
 // table): `rayaudit audit --methods exact --rays 1000000` 0 in every error
 // column, float and double (t at most 1 ulp from the oracle's); kernel
-// bench (hit=50, back=50, nocull) 1.18x watertight's ns per test in float,
-// 1.86x in double (the x87 stage); crack maps 0 leaks, 0 false pixels.
+// bench (hit=50, back=50, nocull) 1.26x watertight's ns per test in float,
+// 1.61x in double (the x87 stage; 1.89x before the division-free
+// certificate); crack maps 0 leaks, 0 false pixels. The BVH's leaves run
+// stage 1 four triangles at a time (exact_simd.h), answering as this code.
 #pragma once
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -230,7 +238,7 @@ struct Edges {
   C n[3];
   double pn[3];
 };
-inline bool tame(double x) { return x == 0 || (std::abs(x) >= 0x1p-300 && std::abs(x) <= 0x1p300); }
+inline bool tame(double x) { return (x == 0) | ((std::abs(x) >= 0x1p-300) & (std::abs(x) <= 0x1p300)); }
 template <class C, class T>
 [[gnu::always_inline]] inline Edges<C> edges(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
   const C ax = C(a.x), ay = C(a.y), az = C(a.z);
@@ -251,7 +259,36 @@ template <class C, class T>
 
 // Stage 1b: t = (n . A') / (n . d) in C with its enclosure (header); `out`
 // when the window is certainly missed, `in` with t_out (when need_t)
-// correctly or faithfully rounded to T when it is certainly met.
+// faithfully rounded to T (correctly, where the enclosure allows) when it
+// is certainly met.
+//
+// The certificate, without a division or a rounding of the enclosure's
+// ends (both cost more than the x87 arithmetic itself). Let t~ = fl_C(N~ /
+// D~), q = T(t~) and delta = t~ - q, exact in C and then in double (the
+// low 11 (double inputs) or 29 (float) bits of t~; |q| >= 2^-900, or 2^-100
+// for float, keeps it normal). With a = eN / |N~|, b = eD / |D~| <= 1/4,
+//   |t / t~ - 1| <= rho = (a + b + u + bu) / ((1 - b)(1 - u)),
+// at most K (a + b + 2u) with K = 1 + 2^-19 when a, b <= 2^-20 and K = 2
+// otherwise. As |t~| = |N~ / D~| (1 + g), |g| <= u, and |t~| <= |q| (1 +
+// 2^-23), |D~| <= aD (1 + 2^-52) (aD = |D~| rounded to double):
+//   rho |t~| |D~| <= K (eN + eD |q| + 2u |q| aD) (1 + 2^-20) <= Y,
+// Y computed in double with the factor 1 + 2^-17 (its 5 roundings of
+// positive terms, 2^-50, inside). Then |t - t~| <= Y / |D~|, and t lies
+// strictly between q's neighbours, at up = ulp(q) away from zero and down =
+// ulp(q) towards it (ulp / 2 when |q| is a power of two), when
+//   s delta + Y / |D~| < up  and  Y / |D~| - s delta < down  (s = sign q),
+// that is Y < (up - s delta) |D~| and Y < (down + s delta) |D~|: the
+// differences are exact (12 or 31 bits at q's ulp scale, both positive as
+// |delta| <= half an ulp), and the products are rounded once each, covered
+// by comparing with them times 1 - 2^-40 (|D~| >= aD (1 - 2^-53)). t is
+// then within 1 ulp of q (faithful; correctly rounded when the same holds
+// with half-ulps), and, q and the window's ends being T values, t >= tlo
+// when q > tlo (t > prev(q) >= tlo) and t < tlo when q < tlo (t < next(q)
+// <= tlo); likewise for thi. A q equal to a window end is left undecided.
+// Where the certificate fails (the enclosure wider than an ulp: grazing
+// rays, about cond > 2^5 for double inputs), the window may still be missed
+// by far: t lies within |t~| rho <= Y / (aD (1 - 2^-52)), compared with a
+// factor 1 + 2^-30 on the division's rounding.
 template <class C, class T>
 [[gnu::always_inline]] inline Dist enclose_t(const Ray<T>& r, const Vec3<T>& a, const Edges<C>& e, bool need_t,
                                              T& t_out) {
@@ -263,35 +300,52 @@ template <class C, class T>
   const double PD =
       e.pn[0] * std::abs(double(r.d.x)) + e.pn[1] * std::abs(double(r.d.y)) + e.pn[2] * std::abs(double(r.d.z));
   if constexpr (sizeof(T) == sizeof(double))
-    if (!(tame(fqx) && tame(fqy) && tame(fqz) && tame(r.d.x) && tame(r.d.y) && tame(r.d.z)))
+    if (!(tame(fqx) & tame(fqy) & tame(fqz) & tame(r.d.x) & tame(r.d.y) & tame(r.d.z)))
       PN = std::numeric_limits<double>::quiet_NaN();
-  // The bounds and the enclosure's relative width in double (one SSE
-  // division, beside the x87 one where C is long double): |N~|, |D~|
-  // rounded to double lose 2^-53 relative, the width's 7 roundings 2^-50,
-  // covered by the factors 1 + 2^-40.
+  // The bounds in double: |N~|, |D~| rounded to double lose 2^-53
+  // relative, covered by the factors 1 + 2^-40.
   constexpr C u = unit_roundoff<C>();
   constexpr double k = double(16 * u) * (1 + 0x1p-48);
   const double eN = k * PN, eD = k * PD;
   const double aN = double(std::abs(N)), aD = double(std::abs(D));
-  if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD))
-    return Dist::undecided;  // t near 0, grazing, untamed (NaN)
-  const C t = N / D;
-  const double rel = (eN * aD + eD * aN) / (aN * aD) * (2 * (1 + 0x1p-40));
-  const C w = std::abs(t) * (C(rel) + C(16) * u);
-  const C lo = t - w, hi = t + w;
-  const C tlo = std::max(C(r.tmin), C(0)), thi = C(r.tmax);
-  if (hi < tlo || lo > thi) return Dist::out;
-  if (!(lo >= tlo && hi <= thi)) return Dist::undecided;  // on the window's edge (or a NaN window)
-  if (need_t) {
-    // Correctly rounded when the whole enclosure rounds to one T; else
-    // faithful when it lies strictly between the neighbours of T(t~): t is
-    // then within 1 ulp of the T returned, on no far side of a neighbour.
-    const T q = T(t);
-    if (T(lo) != T(hi) &&
-        !(std::isfinite(q) && lo > C(std::nextafter(q, T(-INFINITY))) && hi < C(std::nextafter(q, T(INFINITY)))))
-      return Dist::undecided;
-    t_out = q;
+  const T tlo = std::max(r.tmin, T(0)), thi = r.tmax;
+  if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD)) {
+    // t near 0 (N within its error bound), grazing, or untamed (NaN). With
+    // D certain, |t| <= (aN (1 + 2^-52) + eN) / (aD (1 - 2^-53) - eD): a
+    // window starting above that is missed (a shadow ray leaving the
+    // surface, against the triangles it leaves from). The factors 1 -+
+    // 2^-40 cover those and the three roundings here (eD < aD / 4).
+    if (aD > 4 * (1 + 0x1p-40) * eD && (aN + eN) * (1 + 0x1p-40) < (aD - eD) * double(tlo) * (1 - 0x1p-40))
+      return Dist::out;
+    return Dist::undecided;
   }
+  const double K = aN > 0x1p20 * (1 + 0x1p-40) * eN && aD > 0x1p20 * (1 + 0x1p-40) * eD ? 1 + 0x1p-19 : 2;
+  const C t = N / D;
+  const T q = T(t);
+  const double aq = std::abs(double(q));
+  constexpr double kLow = sizeof(T) == sizeof(float) ? 0x1p-100 : 0x1p-900;
+  constexpr double kHigh = sizeof(T) == sizeof(float) ? 0x1p100 : 0x1p1000;
+  if (!(aq >= kLow && aq <= kHigh)) return Dist::undecided;  // t tiny, huge or NaN: the later stages
+  const double sdelta = q < 0 ? double(C(q) - t) : double(t - C(q));
+  // ulp(q): 2^e (|q| in [2^e, 2^(e+1)), its exponent bits) times 2^-52 or 2^-23.
+  constexpr std::uint64_t kExp = 0x7FF0000000000000u;
+  const double pe = std::bit_cast<double>(std::bit_cast<std::uint64_t>(aq) & kExp);
+  const double up = pe * (sizeof(T) == sizeof(float) ? 0x1p-23 : 0x1p-52);
+  const double down = aq == pe ? up * 0.5 : up;
+  const double Y = K * (eN + eD * aq + 2 * double(u) * aq * aD) * (1 + 0x1p-17);
+  if (!(Y < (up - sdelta) * aD * (1 - 0x1p-40) && Y < (down + sdelta) * aD * (1 - 0x1p-40))) {
+    // Wider than an ulp: the window is decided only when the whole
+    // enclosure [q - w, q + w] lies outside it, or (any-hit: no t to
+    // round) inside it; rounding is monotone, so strict comparisons of the
+    // rounded ends with T values hold for the exact ends.
+    const double w = Y / (aD * (1 - 0x1p-30)) + std::abs(sdelta);
+    if (double(q) + w < double(tlo) || double(q) - w > double(thi)) return Dist::out;
+    if (!need_t && double(q) - w > double(tlo) && double(q) + w < double(thi)) return Dist::in;
+    return Dist::undecided;
+  }
+  if (q < tlo || q > thi) return Dist::out;
+  if (!(q > tlo && q < thi)) return Dist::undecided;  // on a window end (or a NaN window)
+  if (need_t) t_out = q;
   return Dist::in;
 }
 
@@ -313,20 +367,19 @@ template <class C, class T>
 template <class T>
 using TCompute = std::conditional_t<sizeof(T) == sizeof(float), double, long double>;
 
-// The test; need_t = false for any-hit (the verdict only). `pre`: the
+// The test after stage 1: sg, U, V, W and s are what signs<double> gave
+// for these inputs (the scalar test below, or a lane of the 4-lane leaf,
+// exact_simd.h, whose lanes compute them by the same operations: the same
+// bits). need_t = false for any-hit (the verdict only). `pre`: the
 // triangle's stage 1b terms if prepared (the same values edges() gives).
 template <class T>
-[[gnu::always_inline]] inline std::optional<TriangleHit<T>> test(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                                                 const Vec3<T>& c, const Edges<TCompute<T>>* pre,
-                                                                 bool cull, bool need_t) {
+[[gnu::always_inline]] inline std::optional<TriangleHit<T>> after_signs(Signs sg, double U, double V, double W, int s,
+                                                                        const Ray<T>& r, const Vec3<T>& a,
+                                                                        const Vec3<T>& b, const Vec3<T>& c,
+                                                                        const Edges<TCompute<T>>* pre, bool cull,
+                                                                        bool need_t) {
   constexpr bool kFloat = sizeof(T) == sizeof(float);
   using C = TCompute<T>;
-  // Double inputs: the double filter's range guard and underflow term.
-  constexpr double kLimit = kFloat ? std::numeric_limits<double>::infinity() : 0x1p330;
-  constexpr double kTau = kFloat ? 0.0 : 0x1p-736;
-  double U, V, W;
-  int s = 0;
-  const Signs sg = signs<double>(r, a, b, c, kLimit, kTau, U, V, W, s);
   if (sg == Signs::miss) return std::nullopt;
   if (sg == Signs::inside) {
     if (cull && s > 0) return std::nullopt;
@@ -338,6 +391,14 @@ template <class T>
     if (ds == Dist::in) return finish<double, T>(t, U, V, W);
     count_exact();
     return hit_exact(r, a, b, c, cull);
+  }
+  // Undecided signs (a ray through or near an edge or vertex): the plane's
+  // t alone may put the crossing outside the window, whatever the signs
+  // (a shadow ray leaving the surface, against the triangles around its
+  // origin; a closest-hit ray behind its best hit).
+  {
+    T t{};
+    if (enclose_t<C>(r, a, pre ? *pre : edges<C>(a, b, c), false, t) == Dist::out) return std::nullopt;
   }
   if constexpr (!kFloat) {
     count_extended();
@@ -355,6 +416,24 @@ template <class T>
   }
   count_exact();
   return hit_exact(r, a, b, c, cull);
+}
+
+// Stage 1's range guard and underflow term (double inputs; float inputs in
+// double need neither).
+template <class T>
+constexpr double kFilterLimit = sizeof(T) == sizeof(float) ? std::numeric_limits<double>::infinity() : 0x1p330;
+template <class T>
+constexpr double kFilterTau = sizeof(T) == sizeof(float) ? 0.0 : 0x1p-736;
+
+// The whole test: stage 1, then the rest.
+template <class T>
+[[gnu::always_inline]] inline std::optional<TriangleHit<T>> test(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
+                                                                 const Vec3<T>& c, const Edges<TCompute<T>>* pre,
+                                                                 bool cull, bool need_t) {
+  double U, V, W;
+  int s = 0;
+  const Signs sg = signs<double>(r, a, b, c, kFilterLimit<T>, kFilterTau<T>, U, V, W, s);
+  return after_signs(sg, U, V, W, s, r, a, b, c, pre, cull, need_t);
 }
 
 // The prepared form: the vertices and the triangle's stage 1b terms.

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "methods/moller.h"
+#include "methods/simd_test_blocks.h"
 
 namespace ra {
 namespace {
@@ -85,23 +86,10 @@ void random_and_edge_rays(std::uint64_t seed) {
 // whose sign the lanes must keep (a broadcast written 0 + x would lose it).
 template <class T>
 void signed_zero_rays() {
-  const T z = T(0), nz = -T(0);
-  const T comps[] = {nz, z, T(0.25), T(-0.25), T(1), T(-1)};
   int hits = 0;
-  for (T ox : comps)
-    for (T oy : comps)
-      for (T dx : {nz, z, T(0.5)})
-        for (T dy : {nz, z, T(-0.5)}) {
-          Ray<T> r;
-          r.o = Vec3<T>(ox, oy, T(1));
-          r.d = Vec3<T>(dx, dy, T(-1));
-          r.tmin = nz;
-          const Vec3<T> v[4][3] = {{Vec3<T>(z, z, z), Vec3<T>(T(1), z, z), Vec3<T>(z, T(1), z)},
-                                   {Vec3<T>(nz, nz, nz), Vec3<T>(z, T(1), z), Vec3<T>(T(1), z, z)},
-                                   {Vec3<T>(T(-1), z, z), Vec3<T>(z, z, z), Vec3<T>(z, T(-1), z)},
-                                   {Vec3<T>(z, z, T(1)), Vec3<T>(T(1), z, T(1)), Vec3<T>(z, T(1), T(1))}};
-          for (bool cull : {false, true}) hits += compare_block(r, v, cull);
-        }
+  for_each_signed_zero_block<T>([&](const Ray<T>& r, const Vec3<T>(&v)[4][3]) {
+    for (bool cull : {false, true}) hits += compare_block(r, v, cull);
+  });
   EXPECT_GT(hits, 0);
 }
 
