@@ -30,7 +30,7 @@ Config& config();
 std::vector<int> thread_counts();
 // Google Benchmark's --benchmark_repetitions and --benchmark_min_time for
 // every row (set globally: per-row settings would append "/min_time:...",
-// "/repeats:..." to the names the issue fixes). So every row's iteration is
+// "/repeats:..." to the names users' scripts read). So every row's iteration is
 // one fixed piece of work (one pass over its rays or its batch), and GB's
 // time per iteration compares across runs (compare.py).
 int repetitions();

@@ -1,6 +1,6 @@
 // `rayaudit bench` run as a user would: the JSON of a small
-// --quick subset holds every group with the names and counters the issue
-// fixes, and bad input is one line, exit 2, nothing written. No timings are
+// --quick subset holds every group with the names and counters users'
+// scripts read (bench/README.md), and bad input is one line, exit 2, nothing written. No timings are
 // asserted (those belong in the benchmark's output).
 #include <gtest/gtest.h>
 
@@ -32,7 +32,7 @@ bool corpus_present() { return fs::exists(ra::cache_dir() / "corpus" / "ladder" 
 
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
-// One row of every kind the issue names; one repetition (the flag passes
+// One row of every group (kernel, scene, peer, obj, oracle); one repetition (the flag passes
 // through to Google Benchmark).
 const char* const kSubset =
     "^(kernel/(moller|watertight)/float/(cull|nocull)/hit=50/back=(0|100)"

@@ -67,7 +67,7 @@ void write_answers(const fs::path& cases, const fs::path& answers, const std::st
   ASSERT_EQ(lose, 0) << "fewer hits than asked to lose";
 }
 
-// The check: an intersector changed to lose 20 grazing hits fails
+// A user's regression gate end to end: an intersector changed to lose 20 grazing hits fails
 // --baseline with a table naming grazing; unchanged, it passes; the JUnit
 // file parses and lists the failure.
 TEST(AuditGate, LosingTwentyGrazingHitsFailsTheBaselineAndTheJUnitSaysWhere) {

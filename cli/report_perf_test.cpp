@@ -230,6 +230,36 @@ TEST(ReportPerf, CombinesRunsFlagsASlowedRowAndLeavesOutASlowRun) {
   EXPECT_NE(html.find("No audit given"), std::string::npos);
   EXPECT_NE(html.find("quick mode, 3 repetitions x 3 run(s)"), std::string::npos);
   EXPECT_NE(html.find("slow phase: left out of the medians"), std::string::npos);
+
+  // Runs of unequal length (reruns, another --benchmark_repetitions): one
+  // repetition at 10 against three at 1. The row's figure, the median of
+  // the two runs' medians, is 5.5; the quartiles of the four pooled
+  // repetitions are 1 and 3.25: the figure lies above them, and the report
+  // still draws it.
+  json one = b, three = b;
+  int kept = 0;
+  json thinned = json::array();
+  for (json& r : one.at("benchmarks")) {
+    if (r.value("run_name", "") == probe && r.at("run_type") == "iteration") {
+      if (kept++) continue;
+      r["ns_per_test"] = 10.0;
+      r["rayaudit_slow_phase"] = false;
+    }
+    thinned.push_back(r);
+  }
+  one["benchmarks"] = thinned;
+  int reps_of_three = 0;
+  for (json& r : three.at("benchmarks"))
+    if (r.value("run_name", "") == probe && r.at("run_type") == "iteration")
+      r["ns_per_test"] = 1.0, r["rayaudit_slow_phase"] = false, ++reps_of_three;
+  ASSERT_EQ(reps_of_three, 3);
+  save(d / "one.json", one);
+  save(d / "three.json", three);
+  const json ru = report("--bench " + (d / "one.json").string() + " --bench " + (d / "three.json").string(), "ru");
+  const json pr = row(ru, probe);
+  ASSERT_FALSE(pr.is_null());
+  EXPECT_DOUBLE_EQ(pr.at("median").get<double>(), 5.5) << pr.dump();
+  EXPECT_DOUBLE_EQ(pr.at("q3").get<double>(), 3.25) << pr.dump();
 }
 
 // Scene and peer rows as a bench writes them (three repetitions each), with

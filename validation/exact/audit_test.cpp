@@ -3,6 +3,7 @@
 #include "audit.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -299,7 +300,8 @@ TEST(AuditExport, RoundTripKeepsEveryVerdict) {
   const auto rows =
       export_rows({"random", "edge", "vertex", "near-miss", "degenerate", "closed-mesh"}, Precision::f64, 11, 3000);
   ASSERT_GT(rows.size(), 1000u);
-  const auto path = std::filesystem::temp_directory_path() / "rayaudit_roundtrip_test.csv";
+  const auto path =
+      std::filesystem::temp_directory_path() / ("rayaudit_roundtrip_test-" + std::to_string(::getpid()) + ".csv");
   { std::ofstream(path) << cases_csv(rows); }
   const auto back = read_cases_csv(path.string());
   std::filesystem::remove(path);
@@ -313,7 +315,8 @@ TEST(AuditExport, RoundTripKeepsEveryVerdict) {
 }
 
 TEST(AuditCasesCsv, MalformedRowsNameFileAndLine) {
-  const auto path = std::filesystem::temp_directory_path() / "rayaudit_bad_cases_test.csv";
+  const auto path =
+      std::filesystem::temp_directory_path() / ("rayaudit_bad_cases_test-" + std::to_string(::getpid()) + ".csv");
   auto expect_error = [&](const std::string& text, const std::string& where) {
     { std::ofstream(path) << text; }
     try {
@@ -333,7 +336,8 @@ TEST(AuditCasesCsv, MalformedRowsNameFileAndLine) {
 }
 
 TEST(AuditCasesCsv, HexAndDecimalFloatsAndIds) {
-  const auto path = std::filesystem::temp_directory_path() / "rayaudit_good_cases_test.csv";
+  const auto path =
+      std::filesystem::temp_directory_path() / ("rayaudit_good_cases_test-" + std::to_string(::getpid()) + ".csv");
   {
     std::ofstream(path) << "note,cz,cy,cx,bz,by,bx,az,ay,ax,dz,dy,dx,oz,oy,ox,id\n"
                            "x,0,0x1p+0,0,0,0,1,0,0,0,-1,0,0,1,0.25,0.25,bug-17\n";

@@ -346,7 +346,10 @@ def chart_kernel_hit_rate(plt, khr, methods, stamp_text):
                     continue
                 x = [h for h, _ in pts]
                 y = [s["median"] for _, s in pts]
-                err = [[s["median"] - s["q1"] for _, s in pts], [s["q3"] - s["median"] for _, s in pts]]
+                # The figure is the median of the runs' medians, the quartiles
+                # are of every repetition pooled: with runs of unequal length
+                # the figure can lie outside them (the bar then starts at it).
+                err = [[max(s["median"] - s["q1"], 0) for _, s in pts], [max(s["q3"] - s["median"], 0) for _, s in pts]]
                 ax.errorbar(x, y, yerr=err, marker="o", ms=3, capsize=2, lw=1.2,
                             ls="--" if methods.is_document(n) else "-", color=methods.colour.get(n, "k"),
                             label=methods.label(n))

@@ -253,7 +253,9 @@ def scatter_panel(ax, entries, methods, yfield, ylabel, title):
         sp = e.get("ns_spread")
         if sp:  # thin: min-max over repetitions and runs; thick: the quartiles
             ax.errorbar([x], [y], xerr=[[x - sp["min"]], [sp["max"] - x]], fmt="none", ecolor=c, lw=0.7, alpha=0.6)
-            ax.errorbar([x], [y], xerr=[[x - sp["q1"]], [sp["q3"] - x]], fmt="none", ecolor=c, lw=2.2, alpha=0.8)
+            # (the figure, a median of run medians, may lie outside the pooled quartiles)
+            ax.errorbar([x], [y], xerr=[[max(x - sp["q1"], 0)], [max(sp["q3"] - x, 0)]], fmt="none", ecolor=c, lw=2.2,
+                        alpha=0.8)
         user = methods.is_user(e["method"])
         ax.scatter([x], [y], s=140 if user else 60,
                    marker="*" if user or e.get("peer") else "o" if e["precision"] == "float" else "s",
