@@ -155,10 +155,12 @@ TEST_P(AccelFar, SameHitsForMeshesFarOutAndScaled) {
           compare(scene, m, dbl, c, scale, c + Vec3d{0.6, -0.7, 0.4} * (away * scale), 0.5 * away * scale, 60, ++seed,
                   n);
           if (HasFatalFailure()) return;
-          // At the origin every method sees the mesh (far out, float may
-          // collapse it, and then every accelerator misses alike): the
+          // At the origin and scale 1e4 every method sees the mesh (far out,
+          // float may collapse it; at 1e-4 a document's absolute epsilon,
+          // sameside's, misses it; then every accelerator misses alike): the
           // identity above must have been tested on hits, not misses only.
-          if (at == 0.0) EXPECT_GE(n.hits, 5) << m.name << (dbl ? "/double" : "/float") << " scale " << scale;
+          if (at == 0.0 && scale > 1)
+            EXPECT_GE(n.hits, 5) << m.name << (dbl ? "/double" : "/float") << " scale " << scale;
         }
     }
 }
