@@ -1226,7 +1226,10 @@ std::string Report::refracted_table() const {
   for (const Row& r : rows) {
     out += fmt("%-9s %-7s %-14s", r.kind.c_str(), r.precision.c_str(), r.strategy.c_str());
     std::uint64_t spawned = 0;
-    for (const auto& [scale, st] : r.scales) {
+    for (const auto& scale_stats : r.scales) {
+      // Not a structured binding: clang (the fuzz build) does not let a
+      // lambda capture one.
+      const auto& st = scale_stats.second;
       spawned += st.spawned;
       auto pct = [&](std::uint64_t v) {
         return st.spawned ? fmt("%.2f", 100.0 * double(v) / double(st.spawned)) : "-";
