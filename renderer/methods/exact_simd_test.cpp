@@ -144,14 +144,8 @@ void random_and_adversarial(std::uint64_t seed, bool avx) {
     Ray<T> r;
     r.o = Vec3<T>(T(3 * u(rng)), T(3 * u(rng)), T(3 * u(rng)));
     // Aim at a point of triangle 0: a vertex, an edge point or an interior point.
-    Vec3<T> target;
     const int kind = (iter / 10) % 3;
-    if (kind == 0)
-      target = v[0][iter % 3];
-    else if (kind == 1)
-      target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng));
-    else
-      target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng) * 0.5) + (v[0][2] - v[0][0]) * T(w(rng) * 0.5);
+    const Vec3<T> target = aim_point(v[0], kind, iter % 3, [&] { return w(rng); });
     if (family == 4) {  // grazing: from a point of the plane, nudged off it
       const Vec3<T> n = cross(v[0][1] - v[0][0], v[0][2] - v[0][0]);
       r.o = v[0][0] + (v[0][0] - target) * T(2) + n * T(1e-6 * w(rng));

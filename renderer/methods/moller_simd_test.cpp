@@ -58,13 +58,7 @@ void random_and_edge_rays(std::uint64_t seed) {
     r.o = Vec3<T>(T(3 * u(rng)), T(3 * u(rng)), T(3 * u(rng)));
     // Aim at a point of triangle 0: a vertex, an edge point or an interior point.
     const int kind = iter % 4;
-    Vec3<T> target;
-    if (kind == 0)
-      target = v[0][iter % 3];
-    else if (kind == 1)
-      target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng));
-    else
-      target = v[0][0] + (v[0][1] - v[0][0]) * T(w(rng) * 0.5) + (v[0][2] - v[0][0]) * T(w(rng) * 0.5);
+    const Vec3<T> target = aim_point(v[0], kind, iter % 3, [&] { return w(rng); });
     r.d = target - r.o;
     if (iter % 13 == 0) r.d = v[0][1] - v[0][0];  // parallel to an edge
     if (iter % 17 == 0) r.d.z = T(0);             // an axis-parallel component

@@ -28,4 +28,15 @@ void for_each_signed_zero_block(F&& f) {
         }
 }
 
+// A point of the triangle t to aim a ray at: its vertex `corner` (kind 0),
+// a point of its edge 0-1 (kind 1) or an interior point (kind 2 and up);
+// `draw` gives uniform numbers in [0, 1).
+template <class T, class Draw>
+Vec3<T> aim_point(const Vec3<T> (&t)[3], int kind, int corner, Draw&& draw) {
+  if (kind == 0) return t[corner];
+  if (kind == 1) return t[0] + (t[1] - t[0]) * T(draw());
+  const T s1 = T(draw() * 0.5), s2 = T(draw() * 0.5);
+  return t[0] + (t[1] - t[0]) * s1 + (t[2] - t[0]) * s2;
+}
+
 }  // namespace ra
