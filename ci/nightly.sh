@@ -9,8 +9,9 @@
 # each step prints its seconds). Then the exact method's audit at 1e8 rays
 # per family and precision, in EXACT_SHARDS shards (default 8, run one after
 # another, each about 1/8 of ~9 hours on 2 cores; set EXACT_RAYS to change
-# 1e8), merged and checked for 0 in every error column.
-# Exit 1 if anything is unexplained or the exact method errs.
+# 1e8), merged and checked for 0 in every error column. Last, every test
+# under ASan + UBSan (ASAN_SCOPE=all ci/asan.sh, about 35 minutes).
+# Exit 1 if anything is unexplained, the exact method errs or a test fails.
 source "$(dirname "$0")/common.sh"
 OUT="${1:-$ROOT/out/nightly}"
 N="${2:-200}"
@@ -63,6 +64,12 @@ else
   failed=1
 fi
 echo "exact audit: $((SECONDS - started)) s"
+
+step "every test under ASan + UBSan (ASAN_SCOPE=all ci/asan.sh; the commit CI runs the unit suites)"
+started=$SECONDS
+ASAN_SCOPE=all ci/asan.sh >"$OUT/asan.log" 2>&1 || { failed=1; tail -60 "$OUT/asan.log"; }
+grep -E "tests passed|tests failed" "$OUT/asan.log" || true
+echo "asan: $((SECONDS - started)) s"
 
 step "done: outputs in $OUT"
 exit $failed

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Command 2 of the README (and what .ci/run runs): install what is missing,
 # build, check the formatting, fetch the mesh corpus into the cache, run the whole test suite
-# through ctest, again on the asan preset (ASan + UBSan; ci/asan.sh), then a
-# 30-second libFuzzer run per parser. Idempotent. Each stage prints its wall
+# through ctest, the unit suites again on the asan preset (ASan + UBSan;
+# ci/asan.sh), then a 30-second libFuzzer run per parser. Idempotent. Each stage prints its wall
 # and CPU time (the budget: 30 minutes on 2 cores).
 build_start=$SECONDS
 source "$(dirname "$0")/common.sh"
@@ -34,9 +34,9 @@ timed corpus ci/fetch-corpus.sh "$RAYAUDIT"
 step "running the test suite (ctest --preset release)"
 timed ctest ctest --preset release -j "$JOBS"
 
-step "the same suite under ASan + UBSan (ci/asan.sh: asan preset build, ctest; pov label sampled)"
+step "the unit suites under ASan + UBSan (ci/asan.sh: asan preset; the nightly runs every test under it)"
 timed asan ci/asan.sh
 
-step "fuzzing every parser (OBJ, MTL, PLY, OFF, scene JSON, cases CSV, tolerance JSON) for ${FUZZ_SECONDS:-30} s each (ci/fuzz.sh)"
+step "fuzzing every parser (OBJ, MTL, PLY, OFF, scene JSON, cases CSV, tolerance JSON) for ${FUZZ_SECONDS:-30} s each, after its regression inputs and bad-input corpus (ci/fuzz.sh)"
 timed fuzz ci/fuzz.sh
 echo "== total: $SECONDS s wall"

@@ -159,8 +159,9 @@ TEST_P(AccelFar, SameHitsForMeshesFarOutAndScaled) {
           // float may collapse it; at 1e-4 a document's absolute epsilon,
           // sameside's, misses it; then every accelerator misses alike): the
           // identity above must have been tested on hits, not misses only.
-          if (at == 0.0 && scale > 1)
+          if (at == 0.0 && scale > 1) {
             EXPECT_GE(n.hits, 5) << m.name << (dbl ? "/double" : "/float") << " scale " << scale;
+          }
         }
     }
 }

@@ -66,7 +66,9 @@ TYPED_TEST(ExactTyped, SharedEdgesNeverLeak) {
     const Ray<T> ray{o, target - o};
     const auto h1 = hit(ray, p0, p1, l), h2 = hit(ray, p1, p0, r);
     EXPECT_TRUE(h1.has_value() || h2.has_value()) << "ray " << i;
-    if (h1 && h2) EXPECT_EQ(h1->t, h2->t) << "ray " << i;
+    if (h1 && h2) {
+      EXPECT_EQ(h1->t, h2->t) << "ray " << i;
+    }
   }
 }
 
@@ -166,7 +168,9 @@ TYPED_TEST(ExactTyped, SubnormalAndNearOverflowScalesDecideAsUnscaled) {
       const T s = std::ldexp(T(1), k);
       const auto hs = hit(Ray<T>{o * s, d * s}, a * s, b * s, c * s);
       ASSERT_EQ(h.has_value(), hs.has_value()) << "case " << i << " at 2^" << k;
-      if (h) EXPECT_EQ(h->t, hs->t) << "case " << i << " at 2^" << k;
+      if (h) {
+        EXPECT_EQ(h->t, hs->t) << "case " << i << " at 2^" << k;
+      }
       ++compared;
     }
   }
@@ -257,7 +261,9 @@ TYPED_TEST(ExactTyped, FilterAgreesWithTheExactPath) {
     // The prepared form answers bit for bit as the direct one.
     const auto p = exact::hit(r, exact::detail::prepare(a, b, c), cull);
     ASSERT_EQ(p.has_value(), f.has_value()) << "case " << i;
-    if (p) EXPECT_TRUE(p->t == f->t && p->b1 == f->b1 && p->b2 == f->b2) << "case " << i;
+    if (p) {
+      EXPECT_TRUE(p->t == f->t && p->b1 == f->b1 && p->b2 == f->b2) << "case " << i;
+    }
     EXPECT_EQ(exact::any(r, a, b, c, cull), e.has_value()) << "case " << i;
     if (f) {
       ++hits;

@@ -901,7 +901,7 @@ Report run(const std::vector<TriangleSubject>& tris, const std::vector<SphereSub
       const bool tri_family = fams[fi]->kind == Kind::triangle;
       if (tri_family != (s < tris.size())) continue;
       for (int w = 0; w < int(fams[fi]->sweep.size()); ++w)
-        rep.cells[cell_index(s, fi, w)] = {s, fams[fi]->name, w, fams[fi]->sweep[std::size_t(w)], {}};
+        rep.cells[cell_index(s, fi, w)] = {s, fams[fi]->name, w, fams[fi]->sweep[std::size_t(w)], {}, {}};
     }
 
   const Shard shard = opt.shard.value_or(Shard{});

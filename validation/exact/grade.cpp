@@ -114,7 +114,7 @@ Report grade_answers(const std::string& answers_csv, const std::string& cases_cs
       const Family* f = find_family(cur.family);
       int w = 0;
       if (f) w = int(std::find(f->sweep.begin(), f->sweep.end(), cur.sweep) - f->sweep.begin());
-      rep.cells.push_back({0, cur.family, w, cur.sweep, {}});
+      rep.cells.push_back({0, cur.family, w, cur.sweep, {}, {}});
     }
     Cell& cell = rep.cells[it->second];
     const std::uint64_t bad = cell.stats.bad();
