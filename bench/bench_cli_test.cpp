@@ -197,6 +197,21 @@ TEST(BenchCli, InterruptedRunWritesNothing) {
     EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
 }
 
+// --runs keeps each run's JSON in a temporary directory ($TMPDIR): an
+// interrupted run removes it, dies of the signal and writes nothing.
+TEST(BenchCli, InterruptedRunsRemoveTheirTemporaryDirectory) {
+  const fs::path out = temp_json("interrupted-runs.json");
+  const fs::path tmp = out.parent_path() / "tmpdir";
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  const auto r = run_rayaudit("bench --quick --runs 2 --json " + out.string() + " --filter kernel/",
+                              "TMPDIR=" + tmp.string() + " timeout -s TERM 4");
+  EXPECT_EQ(r.code, 124) << r.all;  // timeout's code: the run was still going
+  EXPECT_NE(r.err.find("interrupted in run 1 of 2; nothing written"), std::string::npos) << r.all;
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(tmp)) ADD_FAILURE() << "left behind: " << e.path();
+}
+
 // A peer that is not installed is an error before anything runs, not a skip.
 TEST(BenchCli, MissingPovRayIsAnError) {
   if (!corpus_present()) GTEST_SKIP() << "mesh corpus not fetched (ci/fetch-corpus.sh)";

@@ -358,11 +358,21 @@ std::string self_exe(const char* argv0) {
   return ec ? std::string(argv0) : p.string();
 }
 
+// The run in progress under --runs, and the signal that interrupted it: a
+// SIGINT or SIGTERM (Ctrl-C, a CI job's timeout) ends that run and then
+// this process by the normal path, so the temporary directory of the runs'
+// JSONs is removed rather than left behind; the signal is raised again after.
+volatile sig_atomic_t g_child = 0, g_interrupt = 0;
+extern "C" void on_interrupt(int sig) {
+  g_interrupt = sig;
+  if (g_child > 0) kill(pid_t(g_child), SIGTERM);
+}
+
 // --runs N: this program N times, one process after another, each writing
 // its JSON into a temporary directory; then one JSON over all of them.
 int run_processes(const Args& a, const rb::Mode& mode, const char* argv0) {
-  char tmpl[] = "/tmp/rayaudit-bench-runs-XXXXXX";
-  if (!mkdtemp(tmpl)) throw std::runtime_error("cannot make a temporary directory");
+  std::string tmpl = (fs::temp_directory_path() / "rayaudit-bench-runs-XXXXXX").string();  // $TMPDIR or /tmp
+  if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot make a temporary directory in " + tmpl);
   struct Cleanup {
     fs::path p;
     ~Cleanup() {
@@ -370,6 +380,11 @@ int run_processes(const Args& a, const rb::Mode& mode, const char* argv0) {
       fs::remove_all(p, ec);
     }
   } cleanup{tmpl};
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
   const std::string exe = self_exe(argv0);
   rb::Measured m;
   for (int i = 0; i < a.runs; ++i) {
@@ -392,8 +407,16 @@ int run_processes(const Args& a, const rb::Mode& mode, const char* argv0) {
       execv(exe.c_str(), cargv.data());
       _exit(127);
     }
+    g_child = pid;
+    if (g_interrupt) kill(pid, SIGTERM);  // the signal came before g_child was set
     int status = 0;
-    waitpid(pid, &status, 0);
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    g_child = 0;
+    if (g_interrupt) {
+      std::fprintf(stderr, "rayaudit bench: interrupted in run %d of %d; nothing written\n", i + 1, a.runs);
+      return 128 + g_interrupt;  // run() raises it again once the directory is gone
+    }
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
       std::fprintf(stderr, "rayaudit bench: run %d of %d failed%s\n", i + 1, a.runs,
                    a.json.empty() ? "" : "; nothing written");
@@ -431,7 +454,14 @@ int run(int argc, char** argv) {
   mode.runs = a.runs;
   mode.min_time = rb::min_time();
   mode.filter = a.filter;
-  if (a.runs > 1 && !listing) return run_processes(a, mode, argv[0]);
+  if (a.runs > 1 && !listing) {
+    const int rc = run_processes(a, mode, argv[0]);
+    if (g_interrupt) {  // the runs' directory is removed: die of the signal, as the shell expects
+      signal(g_interrupt, SIG_DFL);
+      raise(g_interrupt);
+    }
+    return rc;
+  }
 
   // One repetition per round; the rounds are the repetitions.
   std::vector<std::string> gb_args = {argv[0], "--benchmark_repetitions=1",

@@ -3,13 +3,13 @@
 # in build/fuzz; each replays the committed regression inputs
 # (*/fuzz/regressions/TARGET_*, every past finding, each also a named test
 # beside its parser) and the bad-input corpus's files of its parser's kind
-# (cli/badinput/), then fuzzes for ${FUZZ_SECONDS:-30} seconds from its seed
+# (cli/badinput/), then fuzzes for ${FUZZ_SECONDS:-20} seconds from its seed
 # corpus (new inputs go to build/fuzz/corpus-*, not to git).
 # Fails on any crash; the crashing input is left as build/fuzz/crash-*.
 # FUZZ_TARGETS="ply off" limits the run to some targets.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-secs="${FUZZ_SECONDS:-30}"
+secs="${FUZZ_SECONDS:-20}"
 # target:seed corpus (the regression inputs are replayed by every target of the dir)
 all="obj:renderer/fuzz/corpus/obj mtl:renderer/fuzz/corpus/mtl ply:renderer/fuzz/corpus/ply
      off:renderer/fuzz/corpus/off scene:renderer/fuzz/corpus/scene
@@ -63,7 +63,7 @@ fuzz_one() {
 }
 
 # Each libFuzzer run is one thread: JOBS of them at a time (default: the
-# number of cores), so 7 targets of 30 s take 2 minutes on 2 cores, not 3.5.
+# number of cores), so 7 targets of 20 s take 80 s on 2 cores, not 140.
 jobs_max="${JOBS:-$(nproc)}"
 status=0
 pids=() names=()

@@ -2,7 +2,7 @@
 # Command 2 of the README (and what .ci/run runs): install what is missing,
 # build, check the formatting, fetch the mesh corpus into the cache, run the whole test suite
 # through ctest, the unit suites again on the asan preset (ASan + UBSan;
-# ci/asan.sh), then a 30-second libFuzzer run per parser. Idempotent. Each stage prints its wall
+# ci/asan.sh), then a 20-second libFuzzer run per parser. Idempotent. Each stage prints its wall
 # and CPU time (the budget: 30 minutes on 2 cores).
 build_start=$SECONDS
 source "$(dirname "$0")/common.sh"
@@ -37,6 +37,6 @@ timed ctest ctest --preset release -j "$JOBS"
 step "the unit suites under ASan + UBSan (ci/asan.sh: asan preset; the nightly runs every test under it)"
 timed asan ci/asan.sh
 
-step "fuzzing every parser (OBJ, MTL, PLY, OFF, scene JSON, cases CSV, tolerance JSON) for ${FUZZ_SECONDS:-30} s each, after its regression inputs and bad-input corpus (ci/fuzz.sh)"
+step "fuzzing every parser (OBJ, MTL, PLY, OFF, scene JSON, cases CSV, tolerance JSON) for ${FUZZ_SECONDS:-20} s each, after its regression inputs and bad-input corpus (ci/fuzz.sh)"
 timed fuzz ci/fuzz.sh
 echo "== total: $SECONDS s wall"
