@@ -25,6 +25,10 @@ cd "$(dirname "$0")/.."
 JOBS="${JOBS:-$(nproc)}"
 scope="${ASAN_SCOPE:-units}"
 [ -n "${ASAN_ALL:-}" ] && scope=all
+if [ "$scope" != units ] && [ "$scope" != all ]; then
+  echo "asan.sh: ASAN_SCOPE is 'units' or 'all', not '$scope'" >&2
+  exit 2
+fi
 cmake --preset asan >/dev/null
 
 ctest_args=()
@@ -61,10 +65,6 @@ case "$scope" in
       ctest --preset asan -N -L "$sampled_labels" | sed -n 's/^ *Test *#[0-9]*: /  /p'
       ctest_args=(-E "$sampled_out" -LE "$sampled_labels")
     fi
-    ;;
-  *)
-    echo "asan.sh: ASAN_SCOPE is 'units' or 'all', not '$scope'" >&2
-    exit 2
     ;;
 esac
 if [ -n "${ASAN_LABELS:-}" ]; then ctest_args+=(-L "$ASAN_LABELS"); fi
