@@ -454,3 +454,62 @@ TEST(AuditGrade, GradedAnswersOfAMethodEqualItsAudit) {
 }
 
 }  // namespace
+
+// Double hits are hits beyond the group's exact crossings. Probe 3166312 of
+// the vertex family at offset 0 (seed 1, 1e8 rays), where `exact` showed a
+// double hit with every verdict equal to the oracle's: the fan is not flat,
+// and the ray passes beside the shared vertex through two of its triangles,
+// at two points whose t both round to 1.000000000000006. Two interior
+// crossings are two crossings, whatever their rounded t.
+TEST(AuditGroups, TwoInteriorCrossingsAtOneRoundedTAreNotADoubleHit) {
+  const ra::Rayd ray{{0x1.668ce9d1e5fp+1, -0x1.929d4b76ff84p-2, -0x1.d9aa4445a754p-2},
+                     {-0x1.f8730076ed8fp+0, 0x1.c28d24d2f7f2p-1, -0x1.138c549e456p-2}};
+  const ra::Vec3d v{0x1.a94da659bca8p-1, 0x1.f27cfe2ef07p-2, -0x1.769b4c71f654p-1};
+  const ra::Vec3d p{0x1.176680a403aap-1, -0x1.87ce8cd973ap-2, -0x1.7eeb8f6e8c46p-1};
+  const ra::Vec3d q{0x1.633022dc4a4p-5, 0x1.7d2e7fc4246p-3, -0x1.2abfdef1c803p+0};
+  const ra::Vec3d w{0x1.ce7dfb169316p+0, 0x1.8e662df593e6p-1, -0x1.e262809b83ep-4};
+  const Tri fan[3] = {{v, p, q}, {v, q, w}, {v, w, p}};
+  // What the oracle says, checked here rather than assumed: both first
+  // triangles are crossed strictly inside, at one rounded t, at different
+  // exact points (their planes differ, and the ray lies in neither).
+  const auto a0 = ra::oracle::triangle(ray, v, p, q), a1 = ra::oracle::triangle(ray, v, q, w);
+  ASSERT_EQ(a0.verdict, Verdict::hit);
+  ASSERT_EQ(a1.verdict, Verdict::hit);
+  ASSERT_EQ(a0.t, a1.t);
+  ASSERT_EQ(ra::oracle::triangle(ray, v, w, p).verdict, Verdict::miss);
+  const GivenAnswer right[3] = {{true, a0.t}, {true, a1.t}, {false}};
+  Stats st;
+  grade_probe(st, Precision::f64, ray, fan, right, 3, false);
+  EXPECT_EQ(st.double_hits, 0u);
+  EXPECT_EQ(st.wrong(), 0u);
+  // A subject that also hits the third triangle, where the ray crosses no
+  // third time, is a double hit (and a false hit).
+  const GivenAnswer three[3] = {{true, a0.t}, {true, a1.t}, {true, a0.t}};
+  Stats st3;
+  grade_probe(st3, Precision::f64, ray, fan, three, 3, false);
+  EXPECT_EQ(st3.double_hits, 1u);
+  EXPECT_EQ(st3.false_hits, 1u);
+}
+
+// The flat case the rule was made for: two triangles sharing an edge, a ray
+// crossing one strictly inside; hitting both is one hit too many.
+TEST(AuditGroups, HittingBothTrianglesOfAFlatPairCrossedOnceIsADoubleHit) {
+  const ra::Vec3d a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0}, d{1, 1, 0};
+  const Tri pair[2] = {{a, b, c}, {b, d, c}};
+  const ra::Rayd ray{{0.25, 0.25, 1}, {0, 0, -1}};  // inside (a, b, c) only
+  ASSERT_EQ(ra::oracle::triangle(ray, a, b, c).verdict, Verdict::hit);
+  ASSERT_EQ(ra::oracle::triangle(ray, b, d, c).verdict, Verdict::miss);
+  const GivenAnswer both[2] = {{true, 1.0}, {true, 1.0}};
+  Stats st;
+  grade_probe(st, Precision::f64, ray, pair, both, 2, false);
+  EXPECT_EQ(st.double_hits, 1u);
+  EXPECT_EQ(st.false_hits, 1u);
+  // Through the shared edge exactly: both closed triangles contain the
+  // point, one crossing, and hitting both is right.
+  const ra::Rayd edge{{0.5, 0.5, 1}, {0, 0, -1}};
+  ASSERT_EQ(ra::oracle::triangle(edge, a, b, c).verdict, Verdict::boundary);
+  Stats se;
+  grade_probe(se, Precision::f64, edge, pair, both, 2, false);
+  EXPECT_EQ(se.double_hits, 0u);
+  EXPECT_EQ(se.wrong(), 0u);
+}
