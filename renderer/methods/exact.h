@@ -237,6 +237,37 @@ template <class C>
 struct Edges {
   C n[3];
   double pn[3];
+  C normal(int i) const { return n[i]; }
+};
+
+// The prepared form's copy of them. In long double, n is kept as two
+// doubles whose sum is n exactly: an 80-bit load is microcoded (several
+// times a double's), and the hit path of the prepared double kernel loads
+// three. hi = n rounded to double, lo = n - hi (exact by Sterbenz: hi is
+// within a double's ulp of n; at most 12 bits, so a double holds it), and
+// hi + lo in long double is n again. The range: with tame edges (below)
+// each nonzero component is at least 2^-666 (a difference of two products
+// of factors >= 2^-301, 64-bit significands) and at most 2^602, so hi
+// and lo are normal doubles; with untamed edges pn[0] is NaN and stage 1b
+// decides nothing, whatever n holds.
+template <class C>
+struct StoredEdges : Edges<C> {
+  static StoredEdges from(const Edges<C>& e) { return {e}; }
+};
+template <>
+struct StoredEdges<long double> {
+  double nh[3], nl[3];
+  double pn[3];
+  long double normal(int i) const { return static_cast<long double>(nh[i]) + static_cast<long double>(nl[i]); }
+  static StoredEdges from(const Edges<long double>& e) {
+    StoredEdges s;
+    for (int i = 0; i < 3; ++i) {
+      s.nh[i] = double(e.n[i]);
+      s.nl[i] = double(e.n[i] - static_cast<long double>(s.nh[i]));
+      s.pn[i] = e.pn[i];
+    }
+    return s;
+  }
 };
 inline bool tame(double x) { return (x == 0) | ((std::abs(x) >= 0x1p-300) & (std::abs(x) <= 0x1p300)); }
 template <class C, class T>
@@ -285,28 +316,42 @@ template <class C, class T>
 // with half-ulps), and, q and the window's ends being T values, t >= tlo
 // when q > tlo (t > prev(q) >= tlo) and t < tlo when q < tlo (t < next(q)
 // <= tlo); likewise for thi. A q equal to a window end is left undecided.
+// Tested first without delta: q = T(t~) rounded to nearest puts t~ within
+// half of q's gaps (down / 2 below, up / 2 above), so Y < (down / 2) |D~|
+// (down <= up) alone puts t strictly between q's neighbours, and delta,
+// the return trip of q to the compute type, is needed only for the
+// enclosures between half an ulp and an ulp wide: the same verdicts, and
+// the audit's fallback rates unchanged.
 // Where the certificate fails (the enclosure wider than an ulp: grazing
 // rays, about cond > 2^5 for double inputs), the window may still be missed
 // by far: t lies within |t~| rho <= Y / (aD (1 - 2^-52)), compared with a
 // factor 1 + 2^-30 on the division's rounding.
-template <class C, class T>
-[[gnu::always_inline]] inline Dist enclose_t(const Ray<T>& r, const Vec3<T>& a, const Edges<C>& e, bool need_t,
-                                             T& t_out) {
+template <class C, class T, class E>
+[[gnu::always_inline]] inline Dist enclose_t(const Ray<T>& r, const Vec3<T>& a, const E& e, bool need_t, T& t_out) {
   const C qx = C(a.x) - C(r.o.x), qy = C(a.y) - C(r.o.y), qz = C(a.z) - C(r.o.z);
-  const C N = e.n[0] * qx + e.n[1] * qy + e.n[2] * qz;
-  const C D = e.n[0] * C(r.d.x) + e.n[1] * C(r.d.y) + e.n[2] * C(r.d.z);
+  const C n0 = e.normal(0), n1 = e.normal(1), n2 = e.normal(2);
+  const C N = n0 * qx + n1 * qy + n2 * qz;
+  const C D = n0 * C(r.d.x) + n1 * C(r.d.y) + n2 * C(r.d.z);
   const double fqx = double(a.x) - double(r.o.x), fqy = double(a.y) - double(r.o.y), fqz = double(a.z) - double(r.o.z);
-  double PN = e.pn[0] * std::abs(fqx) + e.pn[1] * std::abs(fqy) + e.pn[2] * std::abs(fqz);
+  const double PN = e.pn[0] * std::abs(fqx) + e.pn[1] * std::abs(fqy) + e.pn[2] * std::abs(fqz);
   const double PD =
       e.pn[0] * std::abs(double(r.d.x)) + e.pn[1] * std::abs(double(r.d.y)) + e.pn[2] * std::abs(double(r.d.z));
-  if constexpr (sizeof(T) == sizeof(double))
-    if (!(tame(fqx) & tame(fqy) & tame(fqz) & tame(r.d.x) & tame(r.d.y) & tame(r.d.z)))
-      PN = std::numeric_limits<double>::quiet_NaN();
   // The bounds in double: |N~|, |D~| rounded to double lose 2^-53
   // relative, covered by the factors 1 + 2^-40.
   constexpr C u = unit_roundoff<C>();
   constexpr double k = double(16 * u) * (1 + 0x1p-48);
-  const double eN = k * PN, eD = k * PD;
+  // Double inputs: the ray's factors |fq_i|, |d_i| are not range-checked
+  // (six checks cost 4% of the kernel). One that overflows makes PN or PD
+  // infinite or NaN, and nothing is certified below: every test compares
+  // with them and fails. Underflow in a product pn_i |fq_i| or pn_i |d_i|
+  // loses at most 2^-1075 each, so 16 u times the permanents exceeds k PN
+  // by at most 16 u 3 2^-1075 < 2^-1130 beyond what k's 2^-48 covers.
+  // Where k PN is below 2^-1021, it is itself off by at most 2^-1075
+  // (underflow) and the sum below by 2^-1074 (rounding), so adding 2^-1073
+  // leaves eN at least k PN + 2^-1075; above 2^-1021, 2^-49 of k PN is
+  // over 2^-1070. Likewise eD. Float inputs never underflow here.
+  constexpr double kUnder = sizeof(T) == sizeof(double) ? 0x1p-1073 : 0.0;
+  const double eN = k * PN + kUnder, eD = k * PD + kUnder;
   const double aN = double(std::abs(N)), aD = double(std::abs(D));
   const T tlo = std::max(r.tmin, T(0)), thi = r.tmax;
   if (!(aN > 4 * (1 + 0x1p-40) * eN && aD > 4 * (1 + 0x1p-40) * eD)) {
@@ -326,14 +371,20 @@ template <class C, class T>
   constexpr double kLow = sizeof(T) == sizeof(float) ? 0x1p-100 : 0x1p-900;
   constexpr double kHigh = sizeof(T) == sizeof(float) ? 0x1p100 : 0x1p1000;
   if (!(aq >= kLow && aq <= kHigh)) return Dist::undecided;  // t tiny, huge or NaN: the later stages
-  const double sdelta = q < 0 ? double(C(q) - t) : double(t - C(q));
   // ulp(q): 2^e (|q| in [2^e, 2^(e+1)), its exponent bits) times 2^-52 or 2^-23.
   constexpr std::uint64_t kExp = 0x7FF0000000000000u;
   const double pe = std::bit_cast<double>(std::bit_cast<std::uint64_t>(aq) & kExp);
   const double up = pe * (sizeof(T) == sizeof(float) ? 0x1p-23 : 0x1p-52);
   const double down = aq == pe ? up * 0.5 : up;
   const double Y = K * (eN + eD * aq + 2 * double(u) * aq * aD) * (1 + 0x1p-17);
-  if (!(Y < (up - sdelta) * aD * (1 - 0x1p-40) && Y < (down + sdelta) * aD * (1 - 0x1p-40))) {
+  // First without delta (half an ulp either side holds t~, q being t~
+  // rounded to nearest): no return trip of q to the x87 stack on the
+  // common path. Then with it, for the enclosures between half an ulp and
+  // an ulp wide.
+  const bool narrow = Y < down * 0.5 * aD * (1 - 0x1p-40);
+  double sdelta = 0;
+  if (!narrow) sdelta = q < 0 ? double(C(q) - t) : double(t - C(q));
+  if (!narrow && !(Y < (up - sdelta) * aD * (1 - 0x1p-40) && Y < (down + sdelta) * aD * (1 - 0x1p-40))) {
     // Wider than an ulp: the window is decided only when the whole
     // enclosure [q - w, q + w] lies outside it, or (any-hit: no t to
     // round) inside it; rounding is monotone, so strict comparisons of the
@@ -376,13 +427,15 @@ template <class T>
 [[gnu::always_inline]] inline std::optional<TriangleHit<T>> after_signs(Signs sg, double U, double V, double W, int s,
                                                                         const Ray<T>& r, const Vec3<T>& a,
                                                                         const Vec3<T>& b, const Vec3<T>& c,
-                                                                        const Edges<TCompute<T>>* pre, bool cull,
+                                                                        const StoredEdges<TCompute<T>>* pre, bool cull,
                                                                         bool need_t) {
   constexpr bool kFloat = sizeof(T) == sizeof(float);
   using C = TCompute<T>;
-  if (sg == Signs::miss) return std::nullopt;
+  // A culled back face is a miss too, tested in the same branch: with half
+  // the rays from behind, two unpredictable branches in a row cost more
+  // than the test itself.
+  if ((sg == Signs::miss) | (cull & (sg == Signs::inside) & (s > 0))) return std::nullopt;
   if (sg == Signs::inside) {
-    if (cull && s > 0) return std::nullopt;
     T t{};
     Dist ds = pre ? enclose_t<C>(r, a, *pre, need_t, t) : enclose_t<C>(r, a, edges<C>(a, b, c), need_t, t);
     if constexpr (!kFloat)
@@ -398,7 +451,8 @@ template <class T>
   // origin; a closest-hit ray behind its best hit).
   {
     T t{};
-    if (enclose_t<C>(r, a, pre ? *pre : edges<C>(a, b, c), false, t) == Dist::out) return std::nullopt;
+    if ((pre ? enclose_t<C>(r, a, *pre, false, t) : enclose_t<C>(r, a, edges<C>(a, b, c), false, t)) == Dist::out)
+      return std::nullopt;
   }
   if constexpr (!kFloat) {
     count_extended();
@@ -408,7 +462,7 @@ template <class T>
     if (sl == Signs::inside) {
       if (cull && s > 0) return std::nullopt;
       T t{};
-      Dist ds = enclose_t<C>(r, a, pre ? *pre : edges<C>(a, b, c), need_t, t);
+      Dist ds = pre ? enclose_t<C>(r, a, *pre, need_t, t) : enclose_t<C>(r, a, edges<C>(a, b, c), need_t, t);
       if (ds == Dist::undecided) ds = t_double_word(r, a, b, c, t);
       if (ds == Dist::out) return std::nullopt;
       if (ds == Dist::in) return finish<long double, T>(t, Ul, Vl, Wl);
@@ -428,7 +482,7 @@ constexpr double kFilterTau = sizeof(T) == sizeof(float) ? 0.0 : 0x1p-736;
 // The whole test: stage 1, then the rest.
 template <class T>
 [[gnu::always_inline]] inline std::optional<TriangleHit<T>> test(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
-                                                                 const Vec3<T>& c, const Edges<TCompute<T>>* pre,
+                                                                 const Vec3<T>& c, const StoredEdges<TCompute<T>>* pre,
                                                                  bool cull, bool need_t) {
   double U, V, W;
   int s = 0;
@@ -440,11 +494,11 @@ template <class T>
 template <class T>
 struct Prepared {
   Vec3<T> a, b, c;
-  Edges<TCompute<T>> e;
+  StoredEdges<TCompute<T>> e;
 };
 template <class T>
 Prepared<T> prepare(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
-  return {a, b, c, edges<TCompute<T>>(a, b, c)};
+  return {a, b, c, StoredEdges<TCompute<T>>::from(edges<TCompute<T>>(a, b, c))};
 }
 
 }  // namespace detail

@@ -278,6 +278,67 @@ TYPED_TEST(ExactTyped, FilterAgreesWithTheExactPath) {
   EXPECT_GT(hits, 2000);
 }
 
+// A ray of ordinary scale against an ordinary triangle, but with a tiny
+// or subnormal direction component or offset from the origin to the first
+// vertex: the filter's bounds take products of those with the triangle's
+// terms, which underflow; they must still bound the error (the filter
+// answers as the exact path, verdict and t, on every case).
+TYPED_TEST(ExactTyped, TinyRayComponentsWithAnOrdinaryTriangle) {
+  using T = TypeParam;
+  constexpr bool kFloat = sizeof(T) == 4;
+  const int lo = kFloat ? -149 : -1074, hi = kFloat ? -100 : -990;
+  std::mt19937 g(17);
+  std::uniform_real_distribution<T> u(-1, 1);
+  std::uniform_int_distribution<int> expo(lo, hi), axis(0, 2), pick(0, 2);
+  int hits = 0, tiny_t = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Vec3<T> a{u(g), u(g), u(g)};
+    const Vec3<T> b{u(g), u(g), u(g)}, c{u(g), u(g), u(g)};
+    Vec3<T> o = Vec3<T>{u(g), u(g), u(g)} * T(3);
+    Vec3<T> d = (a + b + c) * T(1.0 / 3) - o;
+    const int k = axis(g);
+    const T tiny = std::ldexp(T(u(g) < 0 ? -1 : 1), expo(g));
+    switch (pick(g)) {
+      case 0:  // one direction component tiny
+        d[k] = tiny;
+        break;
+      case 1:  // the origin a tiny step from the first vertex (its
+               // coordinate 0 there), the ray across the plane towards the
+               // inside: t is tiny, or the ray starts behind the plane
+        a[k] = 0;
+        o = a;
+        o[k] = tiny;
+        d = cross(b - a, c - a) + ((b + c) * T(0.5) - a) * T(0.25);
+        break;
+      default:  // both
+        a[k] = 0;
+        o = a;
+        o[k] = tiny;
+        d = cross(b - a, c - a) + ((b + c) * T(0.5) - a) * T(0.25);
+        d[(k + 1) % 3] = tiny;
+        break;
+    }
+    const Ray<T> r{o, d};
+    const auto f = exact::hit(r, a, b, c, false);
+    const auto e = exact::hit_exact(r, a, b, c, false);
+    ASSERT_EQ(f.has_value(), e.has_value()) << "case " << i;
+    const auto p = exact::hit(r, exact::detail::prepare(a, b, c), false);
+    ASSERT_EQ(p.has_value(), f.has_value()) << "case " << i;
+    if (f) {
+      ++hits;
+      tiny_t += f->t < T(1e-20);
+      // Faithful: e's t is correctly rounded, f's one of the two T values
+      // around the exact t, so at most one ulp from e's.
+      EXPECT_TRUE(f->t == e->t || f->t == std::nextafter(e->t, T(INFINITY)) ||
+                  f->t == std::nextafter(e->t, -T(INFINITY)))
+          << "case " << i << ": " << f->t << " vs " << e->t;
+      EXPECT_EQ(p->t, f->t) << "case " << i;
+    }
+  }
+  EXPECT_GT(hits, 1000);   // not vacuous
+  EXPECT_GT(tiny_t, 100);  // rays leaving a vertex: t tiny
+}
+
 // Most of a random batch is decided without the exact path.
 TYPED_TEST(ExactTyped, FilterDecidesRandomCases) {
   using T = TypeParam;
