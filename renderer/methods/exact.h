@@ -479,11 +479,35 @@ constexpr double kFilterLimit = sizeof(T) == sizeof(float) ? std::numeric_limits
 template <class T>
 constexpr double kFilterTau = sizeof(T) == sizeof(float) ? 0.0 : 0x1p-736;
 
+// Culling from the prepared normal, before stage 1: det = n . d certainly
+// positive is a back face, culled whatever U, V and W say (a crossing of
+// the back, or a miss). In double from n rounded to double (its high part
+// for double rays): n in the compute type is within 16 u PD of the exact
+// det once dotted with d (stage 1b's bound, eD), rounding it to double and
+// the dot's three roundings add at most 4 2^-53 sum_i |n_i| |d_i| <=
+// 2^-51 PD (1 + 2^-50), so |D~ - det| < 2^-49 PD for both precisions;
+// 2^-48 PD + 2^-1073 covers PD's own roundings and underflow (as stage
+// 1b's eD), and a NaN (untamed edges) or infinite bound certifies nothing.
+// About 15 operations against stage 1's 85: a back face costs a fifth.
+template <class T, class E>
+[[gnu::always_inline]] inline bool certainly_back(const Ray<T>& r, const E& e) {
+  double n0, n1, n2;
+  if constexpr (std::is_same_v<E, StoredEdges<long double>>)
+    n0 = e.nh[0], n1 = e.nh[1], n2 = e.nh[2];
+  else
+    n0 = e.n[0], n1 = e.n[1], n2 = e.n[2];
+  const double dx = double(r.d.x), dy = double(r.d.y), dz = double(r.d.z);
+  const double D = n0 * dx + n1 * dy + n2 * dz;
+  const double PD = e.pn[0] * std::abs(dx) + e.pn[1] * std::abs(dy) + e.pn[2] * std::abs(dz);
+  return D > 0x1p-48 * PD + 0x1p-1073;
+}
+
 // The whole test: stage 1, then the rest.
 template <class T>
 [[gnu::always_inline]] inline std::optional<TriangleHit<T>> test(const Ray<T>& r, const Vec3<T>& a, const Vec3<T>& b,
                                                                  const Vec3<T>& c, const StoredEdges<TCompute<T>>* pre,
                                                                  bool cull, bool need_t) {
+  if (cull && pre && certainly_back(r, *pre)) return std::nullopt;
   double U, V, W;
   int s = 0;
   const Signs sg = signs<double>(r, a, b, c, kFilterLimit<T>, kFilterTau<T>, U, V, W, s);

@@ -339,6 +339,38 @@ TYPED_TEST(ExactTyped, TinyRayComponentsWithAnOrdinaryTriangle) {
   EXPECT_GT(tiny_t, 100);  // rays leaving a vertex: t tiny
 }
 
+// Culling from the prepared normal (before stage 1) rejects only certain
+// back faces: rays all but in the triangle's plane, det of either sign down
+// to a few ulps, culled or not, answer as the direct form and the exact
+// path.
+TYPED_TEST(ExactTyped, PreparedCullingOnNearlyCoplanarRays) {
+  using T = TypeParam;
+  std::mt19937 g(23);
+  std::uniform_real_distribution<T> u(-1, 1);
+  std::uniform_int_distribution<int> ulps(-40, 40);
+  int front = 0, back = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3<T> a{u(g), u(g), u(g)}, b{u(g), u(g), u(g)}, c{u(g), u(g), u(g)};
+    const Vec3<T> target = a + (b - a) * T(0.25) + (c - a) * T(0.25);
+    // Along the plane, then tilted by a few ulps of the normal's direction.
+    const Vec3<T> n = cross(b - a, c - a);
+    const Vec3<T> along = (b - a) * u(g) + (c - a) * u(g);
+    const Vec3<T> d = along + n * (T(ulps(g)) * std::numeric_limits<T>::epsilon());
+    const Ray<T> r{target - d, d};
+    const auto pre = exact::detail::prepare(a, b, c);
+    const auto e = exact::hit_exact(r, a, b, c, true);
+    const auto f = exact::hit(r, pre, true);
+    ASSERT_EQ(f.has_value(), e.has_value()) << "case " << i;
+    ASSERT_EQ(exact::hit(r, a, b, c, true).has_value(), e.has_value()) << "case " << i;
+    ASSERT_EQ(exact::any(r, pre, true), e.has_value()) << "case " << i;
+    const auto all = exact::hit_exact(r, a, b, c, false);
+    front += e.has_value();
+    back += all.has_value() && !e.has_value();
+  }
+  EXPECT_GT(front, 1000);  // both sides met, near det = 0
+  EXPECT_GT(back, 1000);
+}
+
 // Most of a random batch is decided without the exact path.
 TYPED_TEST(ExactTyped, FilterDecidesRandomCases) {
   using T = TypeParam;
