@@ -170,7 +170,7 @@ void run(const Args& a) {
                       {"precision", "float"},
                       {"offsets", opt.offsets},
                       {"legend",
-                       "grey: hit (shaded by angle); red: leak (the oracle or the watertight method finds a crossing, "
+                       "grey: hit (shaded by angle); red: leak (the oracle finds a crossing, "
                        "this method none); blue: hit where the oracle finds no crossing; white: background"}};
   nlohmann::json ms = nlohmann::json::array(), entries = nlohmann::json::array();
   for (const auto& m : meshes) ms.push_back({{"name", m.name}, {"source", m.source}, {"triangles", m.faces.size()}});

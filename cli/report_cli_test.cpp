@@ -246,6 +246,32 @@ TEST(CrackMapsCli, NoLeakNearTheOriginAndRedPixelsAreTheLeaks) {
   fs::remove_all(d);
 }
 
+// The exact method answers as the oracle on every pixel of every map: no
+// leak, no false pixel, at every default offset, at the default size
+// (where the watertight method has false pixels on the sphere at 1e5: they
+// are no crossing, so nobody's leak).
+TEST(CrackMapsCli, ExactHasNoLeakAndNoFalsePixelAtAnyOffset) {
+  const fs::path d = fresh_dir("crack-exact");
+  const auto r =
+      run_rayaudit("crack-maps -o " + (d / "cm").string() +
+                   " --methods exact,watertight --mesh " RAYAUDIT_SOURCE_DIR "/scenes/meshes/tetrahedron.obj");
+  ASSERT_EQ(r.code, 0) << r.all;
+  const auto j = nlohmann::json::parse(slurp(d / "cm" / "crack_maps.json"));
+  ASSERT_EQ(j["maps"].size(), 2u * 4u * 2u);  // sphere + tetrahedron, 4 offsets, 2 methods
+  long long watertight_wrong = 0;
+  for (const auto& m : j["maps"]) {
+    EXPECT_GT(m["surface_pixels"].get<long long>(), 96 * 96 / 20) << m;  // the mesh is in view
+    if (m["method"] == "exact") {
+      EXPECT_EQ(m["leaks"], 0) << m;
+      EXPECT_EQ(m["false_hits"], 0) << m;
+    } else {
+      watertight_wrong += m["leaks"].get<long long>() + m["false_hits"].get<long long>();
+    }
+  }
+  EXPECT_GT(watertight_wrong, 0);  // the maps are hard enough to tell
+  fs::remove_all(d);
+}
+
 // crack-maps names every map before the work: a --mesh named like the
 // built-in sphere would share its maps' names (one of each pair lost), and a
 // name longer than the file system takes failed after the work, leaving a
