@@ -558,7 +558,7 @@ struct Tracer::Impl {
     if (bvh_exact4()) {
       // Huge pages as for moller's blocks: the dragon's 72 MB of blocks
       // in 4 KiB pages cost a TLB miss on most leaves (0.52x Embree on
-      // shadow rays without, 0.87x with, in one session).
+      // shadow rays without, 0.84x with, in one session).
       m.xtri4.reserve(slots / 4);
       advise_huge_pages(m.xtri4.data(), slots / 4 * sizeof(m.xtri4[0]));
       m.xtri4.resize(slots / 4);

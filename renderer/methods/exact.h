@@ -240,6 +240,7 @@ struct Edges {
   C n[3];
   double pn[3];
   C normal(int i) const { return n[i]; }
+  double normal_double(int i) const { return double(n[i]); }
 };
 
 // The prepared form's copy of them. In long double, n is kept as two
@@ -261,6 +262,7 @@ struct StoredEdges<long double> {
   double nh[3], nl[3];
   double pn[3];
   long double normal(int i) const { return static_cast<long double>(nh[i]) + static_cast<long double>(nl[i]); }
+  double normal_double(int i) const { return nh[i]; }
   static StoredEdges from(const Edges<long double>& e) {
     StoredEdges s;
     for (int i = 0; i < 3; ++i) {
@@ -384,8 +386,7 @@ template <class C, class T, class E>
   // common path. Then with it, for the enclosures between half an ulp and
   // an ulp wide.
   const bool narrow = Y < down * 0.5 * aD * (1 - 0x1p-40);
-  double sdelta = 0;
-  if (!narrow) sdelta = q < 0 ? double(C(q) - t) : double(t - C(q));
+  const double sdelta = narrow ? 0 : q < 0 ? double(C(q) - t) : double(t - C(q));
   if (!narrow && !(Y < (up - sdelta) * aD * (1 - 0x1p-40) && Y < (down + sdelta) * aD * (1 - 0x1p-40))) {
     // Wider than an ulp: the window is decided only when the whole
     // enclosure [q - w, q + w] lies outside it, or (any-hit: no t to
@@ -433,13 +434,17 @@ template <class T>
                                                                         bool need_t) {
   constexpr bool kFloat = sizeof(T) == sizeof(float);
   using C = TCompute<T>;
+  // Stage 1b from the prepared terms, or from the vertices.
+  const auto stage1b = [&](bool want_t, T& t) __attribute__((always_inline)) {
+    return pre ? enclose_t<C>(r, a, *pre, want_t, t) : enclose_t<C>(r, a, edges<C>(a, b, c), want_t, t);
+  };
   // A culled back face is a miss too, tested in the same branch: with half
   // the rays from behind, two unpredictable branches in a row cost more
   // than the test itself.
   if ((sg == Signs::miss) | (cull & (sg == Signs::inside) & (s > 0))) return std::nullopt;
   if (sg == Signs::inside) {
     T t{};
-    Dist ds = pre ? enclose_t<C>(r, a, *pre, need_t, t) : enclose_t<C>(r, a, edges<C>(a, b, c), need_t, t);
+    Dist ds = stage1b(need_t, t);
     if constexpr (!kFloat)
       if (ds == Dist::undecided) count_extended(), ds = t_double_word(r, a, b, c, t);
     if (ds == Dist::out) return std::nullopt;
@@ -453,8 +458,7 @@ template <class T>
   // origin; a closest-hit ray behind its best hit).
   {
     T t{};
-    if ((pre ? enclose_t<C>(r, a, *pre, false, t) : enclose_t<C>(r, a, edges<C>(a, b, c), false, t)) == Dist::out)
-      return std::nullopt;
+    if (stage1b(false, t) == Dist::out) return std::nullopt;
   }
   if constexpr (!kFloat) {
     count_extended();
@@ -464,7 +468,7 @@ template <class T>
     if (sl == Signs::inside) {
       if (cull && s > 0) return std::nullopt;
       T t{};
-      Dist ds = pre ? enclose_t<C>(r, a, *pre, need_t, t) : enclose_t<C>(r, a, edges<C>(a, b, c), need_t, t);
+      Dist ds = stage1b(need_t, t);
       if (ds == Dist::undecided) ds = t_double_word(r, a, b, c, t);
       if (ds == Dist::out) return std::nullopt;
       if (ds == Dist::in) return finish<long double, T>(t, Ul, Vl, Wl);
@@ -493,11 +497,7 @@ constexpr double kFilterTau = sizeof(T) == sizeof(float) ? 0.0 : 0x1p-736;
 // About 15 operations against stage 1's 85: a back face costs a fifth.
 template <class T, class E>
 [[gnu::always_inline]] inline bool certainly_back(const Ray<T>& r, const E& e) {
-  double n0, n1, n2;
-  if constexpr (std::is_same_v<E, StoredEdges<long double>>)
-    n0 = e.nh[0], n1 = e.nh[1], n2 = e.nh[2];
-  else
-    n0 = e.n[0], n1 = e.n[1], n2 = e.n[2];
+  const double n0 = e.normal_double(0), n1 = e.normal_double(1), n2 = e.normal_double(2);
   const double dx = double(r.d.x), dy = double(r.d.y), dz = double(r.d.z);
   const double D = n0 * dx + n1 * dy + n2 * dz;
   const double PD = e.pn[0] * std::abs(dx) + e.pn[1] * std::abs(dy) + e.pn[2] * std::abs(dz);
